@@ -1,0 +1,185 @@
+// Purpose: the interfaces a plugin implements: Component, Generator (root source), Filter, Adapter.
+#pragma once
+
+#include <trackflow/items.hpp>
+
+#include <boost/config.hpp>
+
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace trackflow {
+
+class Component;
+
+// One downstream connection: deliver to `target` on its input port `port`.
+struct Link {
+  Component* target = nullptr;
+  int port = 0;
+  ItemMask accepts = 0xFF;  // kinds this link delivers (what the target declared it accepts)
+};
+
+// Counted skips and warnings of one run, merged in run order by the engine.
+struct Diagnostics {
+  struct Entry {
+    std::string node;
+    std::string message;
+  };
+  std::vector<Entry> skips;
+  std::vector<Entry> warnings;
+  void skip(const std::string& node, std::string message) { skips.push_back({node, std::move(message)}); }
+  void warn(const std::string& node, std::string message) { warnings.push_back({node, std::move(message)}); }
+};
+
+// What a component learns at the start of each Monte Carlo run.
+struct RunContext {
+  std::uint64_t run = 0;        // 0-based run index
+  std::uint64_t seed = 0;       // derived from (pipeline seed, run, node id)
+  Diagnostics* diagnostics = nullptr;
+};
+
+// Per-run result a component hands to the engine (metrics sinks, CSV writers).
+struct BOOST_SYMBOL_VISIBLE RunResult {
+  virtual ~RunResult() = default;
+};
+
+struct Metric {
+  std::string name;
+  double value = 0.0;
+  std::string unit;
+  bool has_band = false;  // a two-sided acceptance band, e.g. chi-square bounds of ANEES
+  double band_lo = 0.0, band_hi = 0.0, confidence = 0.0;
+};
+
+// What one node contributes to the end-of-pipeline summary and to --metrics-json.
+struct Summary {
+  std::vector<Metric> metrics;
+  std::vector<std::string> notes;
+  std::vector<std::string> files;
+  void metric(std::string name, double v, std::string unit = {}) {
+    metrics.push_back({std::move(name), v, std::move(unit)});
+  }
+  void metric_band(std::string name, double v, double lo, double hi, double confidence) {
+    metrics.push_back({std::move(name), v, {}, true, lo, hi, confidence});
+  }
+  const Metric* find(const std::string& name) const {
+    for (const auto& m : metrics)
+      if (m.name == name) return &m;
+    return nullptr;
+  }
+};
+
+struct FinishContext {
+  std::string node;
+  std::string output_dir;   // --out, created on demand by the component that writes
+  std::uint64_t runs = 1;
+};
+
+// Fan-out list of a node, filled by the engine. emit() is inline: one indirect call per consumer.
+class Outputs {
+ public:
+  void connect(const Link* links, int count) {
+    links_ = links;
+    count_ = count;
+  }
+  inline void emit(const Truth& t) const;
+  inline void emit(const Measurement& m) const;
+  inline void emit(const Estimate& e) const;
+  int count() const { return count_; }
+
+ private:
+  const Link* links_ = nullptr;
+  int count_ = 0;
+};
+
+// Base of every pipeline node. The engine builds one instance per worker thread (plus one
+// that aggregates), calls start_run() before each run, delivers items, then end_run().
+class BOOST_SYMBOL_VISIBLE Component {
+ public:
+  virtual ~Component() = default;
+  virtual void start_run(const RunContext&) {}
+  // Items arriving on input `port` (the position of the source in the node's `inputs:`).
+  virtual void on_truth(const Truth&, int port);
+  virtual void on_measurement(const Measurement&, int port);
+  virtual void on_estimate(const Estimate&, int port);
+  // Called after the last item of a run; the result (may be null) goes to merge() of the
+  // aggregating instance, in run order, so reductions are identical whatever the thread count.
+  virtual std::unique_ptr<RunResult> end_run() { return nullptr; }
+  virtual void merge(RunResult&) {}
+  // Called once on the aggregating instance after all runs.
+  virtual void finish(Summary&, const FinishContext&) {}
+
+  Outputs out;
+};
+
+// A node with no inputs that produces items itself (simulated trajectory, recorded log).
+class BOOST_SYMBOL_VISIBLE Generator : public Component {
+ public:
+  // Time of the next item, or +infinity when the run's data are exhausted.
+  virtual double next_time() const = 0;
+  // Emits the item(s) at next_time() through `out`.
+  virtual void emit_next() = 0;
+};
+
+class Filter;
+
+// Attached to a filter in YAML (`attach_to: <filter id>`); retunes Q and R between steps.
+class BOOST_SYMBOL_VISIBLE Adapter : public Component {
+ public:
+  // Called before the filter uses `m`, and after it has produced `e` from it.
+  virtual void before_update(const Measurement& m, Filter& f);
+  virtual void after_update(const Measurement& m, const Estimate& e, Filter& f);
+  // Checked when the pipeline is built: empty string if this adapter can drive `f`.
+  virtual std::string incompatibility(Filter& f);
+};
+
+// The noise a filter lets adapters read and overwrite. Null members are not exposed.
+struct NoiseHandles {
+  MeasCov* measurement_noise = nullptr;  // R in the filter's measurement space
+  double* process_noise = nullptr;       // intensities q (one per axis or one in all)
+  int process_noise_count = 0;
+  const char* measurement_space = "";     // e.g. "cartesian_position", "spherical"
+};
+
+class BOOST_SYMBOL_VISIBLE Filter : public Component {
+ public:
+  static constexpr int kMaxAdapters = 4;
+  virtual NoiseHandles noise() { return {}; }
+  // Engine side: returns false when the filter already has kMaxAdapters adapters.
+  bool attach(Adapter* a) {
+    if (adapter_count_ >= kMaxAdapters) return false;
+    adapters_[adapter_count_++] = a;
+    return true;
+  }
+
+ protected:
+  void before_update(const Measurement& m) {
+    for (int i = 0; i < adapter_count_; ++i) adapters_[i]->before_update(m, *this);
+  }
+  // Lets adapters see the result, then sends it downstream.
+  void publish(const Measurement& m, const Estimate& e) {
+    for (int i = 0; i < adapter_count_; ++i) adapters_[i]->after_update(m, e, *this);
+    out.emit(e);
+  }
+
+ private:
+  Adapter* adapters_[kMaxAdapters] = {};
+  int adapter_count_ = 0;
+};
+
+inline void Outputs::emit(const Truth& t) const {
+  for (int i = 0; i < count_; ++i)
+    if (links_[i].accepts & mask(ItemKind::Truth)) links_[i].target->on_truth(t, links_[i].port);
+}
+inline void Outputs::emit(const Measurement& m) const {
+  for (int i = 0; i < count_; ++i)
+    if (links_[i].accepts & mask(ItemKind::Measurement)) links_[i].target->on_measurement(m, links_[i].port);
+}
+inline void Outputs::emit(const Estimate& e) const {
+  for (int i = 0; i < count_; ++i)
+    if (links_[i].accepts & mask(ItemKind::Estimate)) links_[i].target->on_estimate(e, links_[i].port);
+}
+
+}  // namespace trackflow

@@ -1,0 +1,79 @@
+// Purpose: the analyst's pipeline file as a located value tree and its parsed top-level structure.
+#pragma once
+
+#include <trackflow/error.hpp>
+
+#include <cstdint>
+#include <memory>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace trackflow::host {
+
+// YAML reduced to what trackflow needs, every node remembering where it was written.
+struct Value {
+  enum class Kind { Null, Scalar, List, Map };
+  Kind kind = Kind::Null;
+  std::string scalar;
+  std::vector<Value> items;
+  std::vector<std::pair<std::string, Value>> entries;  // map, in file order
+  std::vector<SourceLoc> key_locs;                      // location of each map key
+  SourceLoc loc;
+
+  const Value* find(const std::string& key) const;
+  Value* find(const std::string& key);
+  SourceLoc key_loc(const std::string& key) const;
+  bool is_scalar() const { return kind == Kind::Scalar; }
+  std::string describe() const;  // "a map", "a list", "'abc'"
+};
+
+Value load_yaml_file(const std::string& path);
+Value load_yaml_string(const std::string& text, const std::string& name);
+
+struct NodeConfig {
+  std::string id;
+  std::string type;
+  std::vector<std::string> inputs;
+  std::vector<SourceLoc> input_locs;
+  std::string attach_to;  // adapters: the filter they retune
+  SourceLoc attach_loc;
+  Value params;           // Map or Null
+  SourceLoc loc;          // the node's "- id:" line
+  SourceLoc type_loc;
+};
+
+struct ExpectConfig {
+  std::string node;
+  std::string metric;
+  std::string op;    // min, max, within_band, equals (with tolerance)
+  double value = 0;
+  double tolerance = 0;
+  SourceLoc loc;
+};
+
+struct PipelineConfig {
+  std::string file;  // path as given
+  std::string name;
+  std::string description;
+  std::uint64_t seed = 1;
+  std::uint64_t runs = 1;
+  std::string on_bad_row = "error";
+  std::vector<std::string> plugin_paths;  // resolved relative to the file
+  std::vector<NodeConfig> nodes;
+  std::vector<ExpectConfig> expects;
+};
+
+// A `--set node.param=value` override, applied to the tree before validation.
+struct Override {
+  std::string node, param, value;
+};
+Override parse_override(const std::string& text);
+
+// Reads the structure (not the parameters: those are validated against each component's
+// declaration later). Throws ConfigError with file:line:col.
+PipelineConfig parse_pipeline(const Value& root, const std::string& file,
+                              const std::vector<Override>& overrides = {});
+
+}  // namespace trackflow::host

@@ -1,0 +1,40 @@
+// Purpose: turns a parsed pipeline into a checked graph: types resolved, parameters validated, wiring typed, no cycles.
+#pragma once
+
+#include <trackflow/host/config.hpp>
+#include <trackflow/host/plugins.hpp>
+
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace trackflow::host {
+
+struct GraphNode {
+  NodeConfig config;
+  const RegisteredType* type = nullptr;
+  Params params;
+  std::vector<int> inputs;   // indices of upstream nodes, in `inputs:` order (= port numbers)
+  std::vector<ItemMask> input_kinds;  // what each input delivers: upstream produces ∩ this accepts
+  int attach_to = -1;        // adapters: index of the filter
+};
+
+struct Graph {
+  PipelineConfig config;
+  std::vector<GraphNode> nodes;
+  std::vector<int> order;    // topological: every node after its inputs
+};
+
+// Collects nothing silently: the first problem is thrown as a ConfigError naming file:line:col
+// and the node id. Also instantiates each component once so plugin-side checks run now.
+Graph build_graph(PipelineConfig cfg, const PluginRegistry& registry);
+
+// One instantiated copy of the graph (one per worker thread).
+struct GraphInstance {
+  std::vector<std::shared_ptr<Component>> components;  // by node index
+  std::vector<std::vector<Link>> links;                 // by node index
+  std::vector<int> roots;                               // generator nodes
+};
+GraphInstance instantiate(const Graph& g, const PluginRegistry& registry);
+
+}  // namespace trackflow::host

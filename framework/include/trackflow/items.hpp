@@ -1,0 +1,83 @@
+// Purpose: the data items that flow through a pipeline: Truth, Measurement, Estimate.
+#pragma once
+
+#include <Eigen/Core>
+#include <cstdint>
+
+namespace trackflow {
+
+// Largest state a filter may publish and largest measurement vector. Storage is inline
+// (Eigen's MaxRows) so items never touch the heap.
+inline constexpr int kMaxStateDim = 16;
+inline constexpr int kMaxMeasDim = 6;
+
+using StateVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxStateDim, 1>;
+using StateCov = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxStateDim, kMaxStateDim>;
+using MeasVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxMeasDim, 1>;
+using MeasCov = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxMeasDim, kMaxMeasDim>;
+using Vec3 = Eigen::Vector3d;
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+using Mat3 = Eigen::Matrix3d;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+
+enum class ItemKind : std::uint8_t { Truth = 1, Measurement = 2, Estimate = 4 };
+using ItemMask = std::uint8_t;
+constexpr ItemMask mask(ItemKind k) { return static_cast<ItemMask>(k); }
+constexpr ItemMask operator|(ItemKind a, ItemKind b) { return mask(a) | mask(b); }
+const char* to_string(ItemKind k);
+
+// Target state in the pipeline's local ENU frame (x east, y north, z up), metres and seconds.
+struct Truth {
+  double time = 0.0;
+  std::uint32_t target = 0;
+  Vec3 position = Vec3::Zero();
+  Vec3 velocity = Vec3::Zero();
+  Vec3 acceleration = Vec3::Zero();
+};
+
+// Spherical: value = [range, azimuth, elevation(, range_rate)].
+// Cartesian: value = [x, y, z(, range_rate)] in the ENU frame (origin included).
+enum class Frame : std::uint8_t { Spherical, Cartesian };
+
+// north_clockwise: compass bearing, x = r cos(el) sin(az), y = r cos(el) cos(az).
+// x_counterclockwise: mathematical angle from x (east) toward y (north).
+enum class AzimuthConvention : std::uint8_t { NorthClockwise, XCounterClockwise };
+
+enum class MeasMode : std::uint8_t { Unknown, Skin, Beacon };
+
+struct Measurement {
+  double time = 0.0;
+  std::uint32_t sensor = 0;
+  Frame frame = Frame::Spherical;
+  AzimuthConvention azimuth = AzimuthConvention::NorthClockwise;
+  MeasMode mode = MeasMode::Unknown;
+  bool valid = true;            // false: radar not locked / data flagged; filters coast
+  bool has_range_rate = false;  // last element of value is range rate
+  bool has_snr = false;
+  double snr_db = 0.0;
+  Vec3 sensor_position = Vec3::Zero();  // sensor location in the ENU frame
+  MeasVec value;
+  MeasCov covariance;
+
+  int position_dim() const { return 3; }
+};
+
+// What a filter publishes after each step. Whatever the filter's own state (Cartesian CV/CA,
+// spherical, ...), it also fills the ENU position/velocity block so metrics and sinks need
+// no knowledge of the state layout.
+struct Estimate {
+  double time = 0.0;
+  std::uint32_t target = 0;
+  bool updated = false;        // false: prediction only (coasting, invalid measurement)
+  bool initialised = false;    // false while the filter is still collecting its first points
+  StateVec state;
+  StateCov covariance;
+  Vec6 enu;                    // [x y z vx vy vz]
+  Mat6 enu_covariance;
+  MeasVec innovation;          // empty when not updated
+  MeasCov innovation_covariance;
+  double nis = 0.0;            // innovation' S^-1 innovation, valid when updated
+  int quality[3] = {-1, -1, -1};  // per-channel grade set by quality adapters, -1: none
+};
+
+}  // namespace trackflow

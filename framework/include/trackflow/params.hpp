@@ -1,0 +1,106 @@
+// Purpose: a component's parameter declaration (name, type, unit, default, doc) and the validated values it receives.
+#pragma once
+
+#include <trackflow/error.hpp>
+#include <trackflow/items.hpp>
+#include <trackflow/units.hpp>
+
+#include <limits>
+#include <string>
+#include <string_view>
+#include <utility>
+#include <vector>
+
+namespace trackflow {
+
+enum class ParamType {
+  Real,      // a quantity with a dimension: "10 m", "3 mrad", 0.5
+  Integer,
+  Boolean,
+  String,
+  Choice,    // one of a fixed list of words
+  RealList,  // [1, 2, 3] or [1 km, 2 km]; each element has the declared dimension
+  Records,   // a list of maps, each validated against `fields` (e.g. trajectory segments)
+};
+const char* to_string(ParamType t);
+
+// One declared parameter. Validation, `trackflow describe` and the docs are derived from it.
+struct ParamSpec {
+  std::string name;
+  ParamType type = ParamType::Real;
+  Dimension dimension;            // Real and RealList only
+  std::string doc;                // one line
+  bool required = false;
+  std::string default_text;       // as an analyst would write it ("10 m"); empty: no default
+  std::vector<std::string> choices;
+  std::vector<ParamSpec> fields;  // Records only
+  double min = -std::numeric_limits<double>::infinity();  // SI, inclusive
+  double max = std::numeric_limits<double>::infinity();
+  int list_size = -1;             // RealList: exact length when >= 0
+
+  // Fluent construction, e.g.
+  //   ParamSpec::real("sigma_range", dim::length, "range noise σ").def("10 m").at_least(0)
+  static ParamSpec real(std::string name, Dimension d, std::string doc);
+  static ParamSpec integer(std::string name, std::string doc);
+  static ParamSpec boolean(std::string name, std::string doc);
+  static ParamSpec string(std::string name, std::string doc);
+  static ParamSpec choice(std::string name, std::vector<std::string> choices, std::string doc);
+  static ParamSpec real_list(std::string name, Dimension d, std::string doc, int size = -1);
+  static ParamSpec records(std::string name, std::vector<ParamSpec> fields, std::string doc);
+  ParamSpec def(std::string text) && { default_text = std::move(text); return std::move(*this); }
+  ParamSpec req() && { required = true; return std::move(*this); }
+  ParamSpec at_least(double v) && { min = v; return std::move(*this); }
+  ParamSpec at_most(double v) && { max = v; return std::move(*this); }
+  ParamSpec positive() && { min = std::numeric_limits<double>::denorm_min(); return std::move(*this); }
+};
+
+class Params;
+
+struct ParamValue {
+  ParamType type = ParamType::Real;
+  double real = 0.0;
+  long long integer = 0;
+  bool boolean = false;
+  std::string text;
+  std::vector<double> reals;
+  std::vector<Params> records;
+  SourceLoc where;
+  bool from_default = false;
+};
+
+// Validated parameters of one node (or of one record inside a Records parameter).
+// Getters throw ConfigError naming the node if a name was not declared with that type.
+class Params {
+ public:
+  Params() = default;
+  Params(std::string node, SourceLoc where) : node_(std::move(node)), where_(std::move(where)) {}
+
+  double real(std::string_view name) const;
+  long long integer(std::string_view name) const;
+  bool boolean(std::string_view name) const;
+  const std::string& text(std::string_view name) const;  // String and Choice
+  const std::vector<double>& reals(std::string_view name) const;
+  Vec3 vec3(std::string_view name) const;                // RealList of size 3
+  const std::vector<Params>& records(std::string_view name) const;
+  double real_or(std::string_view name, double fallback) const { return has(name) ? real(name) : fallback; }
+
+  bool has(std::string_view name) const;    // a value exists (given or defaulted)
+  bool given(std::string_view name) const;  // the analyst wrote it
+  SourceLoc where(std::string_view name) const;
+  const SourceLoc& where() const { return where_; }
+  const std::string& node() const { return node_; }
+  // A ConfigError pointing at the parameter's line in the analyst's file.
+  ConfigError error(std::string_view name, const std::string& message) const;
+
+  // Engine side.
+  void set(std::string name, ParamValue v) { values_.emplace_back(std::move(name), std::move(v)); }
+  const std::vector<std::pair<std::string, ParamValue>>& values() const { return values_; }
+
+ private:
+  const ParamValue& get(std::string_view name, ParamType expected) const;
+  std::string node_;
+  SourceLoc where_;
+  std::vector<std::pair<std::string, ParamValue>> values_;
+};
+
+}  // namespace trackflow

@@ -1,0 +1,37 @@
+// Purpose: how a plugin declares its component types (kind, ports, parameters, factory) to the host.
+#pragma once
+
+#include <trackflow/component.hpp>
+#include <trackflow/params.hpp>
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace trackflow {
+
+enum class ComponentKind { Source, Converter, Filter, Adapter, Sink };
+const char* to_string(ComponentKind k);
+
+// Declaration of one component type, separate from any pipeline that uses it.
+struct ComponentDecl {
+  std::string type;          // "filter.kalman"
+  ComponentKind kind = ComponentKind::Filter;
+  std::string summary;       // one line
+  std::string doc;           // optional paragraph: equations, sources
+  std::vector<ParamSpec> params;
+  ItemMask accepts = 0;      // item kinds accepted on inputs
+  int min_inputs = 1;
+  int max_inputs = 1;        // -1: unbounded
+  ItemMask produces = 0;     // item kinds emitted
+  std::function<std::unique_ptr<Component>(const Params&)> create;
+};
+
+class Registrar {
+ public:
+  virtual ~Registrar() = default;
+  virtual void add(ComponentDecl decl) = 0;
+};
+
+}  // namespace trackflow

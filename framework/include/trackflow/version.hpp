@@ -1,0 +1,11 @@
+// Purpose: SDK and plugin ABI version numbers checked when a plugin is loaded.
+#pragma once
+
+namespace trackflow {
+
+// Bump kAbiVersion whenever a type that crosses the plugin boundary changes layout or
+// a virtual function is added, removed or reordered. The loader refuses mismatches.
+inline constexpr int kAbiVersion = 1;
+inline constexpr const char* kSdkVersion = "0.1.0";
+
+}  // namespace trackflow

@@ -1,0 +1,40 @@
+// Purpose: default behaviour of the SDK base classes and names of the SDK enums.
+#include <trackflow/component.hpp>
+#include <trackflow/error.hpp>
+#include <trackflow/registry.hpp>
+
+namespace trackflow {
+
+const char* to_string(ItemKind k) {
+  switch (k) {
+    case ItemKind::Truth: return "truth";
+    case ItemKind::Measurement: return "measurement";
+    case ItemKind::Estimate: return "estimate";
+  }
+  return "?";
+}
+
+const char* to_string(ComponentKind k) {
+  switch (k) {
+    case ComponentKind::Source: return "source";
+    case ComponentKind::Converter: return "converter";
+    case ComponentKind::Filter: return "filter";
+    case ComponentKind::Adapter: return "adapter";
+    case ComponentKind::Sink: return "sink";
+  }
+  return "?";
+}
+
+// The graph builder checks item kinds against each declaration, so reaching these means a
+// plugin declared `accepts` it does not implement.
+void Component::on_truth(const Truth&, int) { throw std::logic_error("component received truth it does not handle"); }
+void Component::on_measurement(const Measurement&, int) {
+  throw std::logic_error("component received a measurement it does not handle");
+}
+void Component::on_estimate(const Estimate&, int) { throw std::logic_error("component received an estimate it does not handle"); }
+
+void Adapter::before_update(const Measurement&, Filter&) {}
+void Adapter::after_update(const Measurement&, const Estimate&, Filter&) {}
+std::string Adapter::incompatibility(Filter&) { return {}; }
+
+}  // namespace trackflow

@@ -1,0 +1,193 @@
+// Purpose: graph construction and checks (types, parameters, wiring, cycles) and per-thread instantiation.
+#include <trackflow/host/graph.hpp>
+#include <trackflow/host/suggest.hpp>
+#include <trackflow/host/validate.hpp>
+
+#include <algorithm>
+#include <map>
+
+namespace trackflow::host {
+namespace {
+
+std::string kinds(ItemMask m) {
+  std::vector<std::string> k;
+  for (ItemKind i : {ItemKind::Truth, ItemKind::Measurement, ItemKind::Estimate})
+    if (m & mask(i)) k.push_back(to_string(i));
+  return k.empty() ? "nothing" : join(k, "/");
+}
+
+std::string unknown_type_message(const std::string& type, const PluginRegistry& reg) {
+  const auto names = reg.type_names();
+  std::string m = "unknown type '" + type + "'" + did_you_mean(type, names) + ". Available: " +
+                  (names.empty() ? "none" : join(names)) + ". Searched: " + join(reg.searched());
+  for (const auto& p : reg.problems()) m += "\n  plugin not loaded: " + p.str();
+  return m;
+}
+
+}  // namespace
+
+Graph build_graph(PipelineConfig cfg, const PluginRegistry& registry) {
+  Graph g;
+  g.config = std::move(cfg);
+  std::map<std::string, int> index;
+  std::vector<std::string> ids;
+  for (size_t i = 0; i < g.config.nodes.size(); ++i) {
+    index[g.config.nodes[i].id] = static_cast<int>(i);
+    ids.push_back(g.config.nodes[i].id);
+  }
+  for (const auto& nc : g.config.nodes) {
+    GraphNode n;
+    n.config = nc;
+    n.type = registry.find(nc.type);
+    if (!n.type) throw ConfigError(unknown_type_message(nc.type, registry), nc.type_loc, nc.id);
+    const ComponentDecl& d = n.type->decl;
+    // A pipeline-wide on_bad_row applies to every node that declares the parameter.
+    Value params = nc.params;
+    const bool declares_bad_row =
+        std::any_of(d.params.begin(), d.params.end(), [](const ParamSpec& s) { return s.name == "on_bad_row"; });
+    if (declares_bad_row && !params.find("on_bad_row")) {
+      if (params.kind != Value::Kind::Map) params.kind = Value::Kind::Map;
+      Value v;
+      v.kind = Value::Kind::Scalar;
+      v.scalar = g.config.on_bad_row;
+      v.loc = params.loc;
+      params.entries.emplace_back("on_bad_row", v);
+      params.key_locs.push_back(params.loc);
+    }
+    n.params = validate_params(d.params, params, nc.id, nc.loc);
+    for (size_t k = 0; k < nc.inputs.size(); ++k) {
+      const auto& in = nc.inputs[k];
+      auto it = index.find(in);
+      if (it == index.end())
+        throw ConfigError("input '" + in + "' is not a node" + did_you_mean(in, ids) + "; nodes: " + join(ids),
+                          nc.input_locs[k], nc.id);
+      if (in == nc.id) throw ConfigError("node takes its own output as input (a cycle)", nc.input_locs[k], nc.id);
+      n.inputs.push_back(it->second);
+    }
+    const int count = static_cast<int>(n.inputs.size());
+    if (count < d.min_inputs || (d.max_inputs >= 0 && count > d.max_inputs)) {
+      std::string want = d.max_inputs < 0 ? "at least " + std::to_string(d.min_inputs)
+                         : d.min_inputs == d.max_inputs
+                             ? std::to_string(d.min_inputs)
+                             : std::to_string(d.min_inputs) + " to " + std::to_string(d.max_inputs);
+      throw ConfigError(nc.type + " takes " + want + " input(s) (" + kinds(d.accepts) + "), got " +
+                            std::to_string(count),
+                        nc.loc, nc.id);
+    }
+    if (d.kind == ComponentKind::Adapter) {
+      if (nc.attach_to.empty())
+        throw ConfigError("adapter needs 'attach_to: <filter id>' naming the filter it retunes", nc.loc, nc.id);
+    } else if (!nc.attach_to.empty()) {
+      throw ConfigError("'attach_to' is only for adapters; " + nc.type + " is a " + to_string(d.kind), nc.attach_loc,
+                        nc.id);
+    }
+    g.nodes.push_back(std::move(n));
+  }
+
+  // Wiring: each input must deliver something this node accepts.
+  for (auto& n : g.nodes) {
+    const ComponentDecl& d = n.type->decl;
+    for (size_t k = 0; k < n.inputs.size(); ++k) {
+      const GraphNode& up = g.nodes[n.inputs[k]];
+      const ItemMask m = up.type->decl.produces & d.accepts;
+      if (m == 0)
+        throw ConfigError("input '" + up.config.id + "' (" + up.config.type + ") produces " +
+                              kinds(up.type->decl.produces) + ", but " + n.config.type + " accepts " +
+                              kinds(d.accepts),
+                          n.config.input_locs[k], n.config.id);
+      n.input_kinds.push_back(m);
+    }
+    if (!n.config.attach_to.empty()) {
+      auto it = index.find(n.config.attach_to);
+      if (it == index.end())
+        throw ConfigError("attach_to '" + n.config.attach_to + "' is not a node" + did_you_mean(n.config.attach_to, ids),
+                          n.config.attach_loc, n.config.id);
+      if (g.nodes[it->second].type->decl.kind != ComponentKind::Filter)
+        throw ConfigError("attach_to '" + n.config.attach_to + "' is a " +
+                              to_string(g.nodes[it->second].type->decl.kind) + ", not a filter",
+                          n.config.attach_loc, n.config.id);
+      n.attach_to = it->second;
+    }
+  }
+
+  // Kahn's algorithm; whatever is left over lies on a cycle.
+  const int N = static_cast<int>(g.nodes.size());
+  std::vector<int> pending(N);
+  for (int i = 0; i < N; ++i) pending[i] = static_cast<int>(g.nodes[i].inputs.size());
+  std::vector<bool> done(N, false);
+  for (bool progress = true; progress;) {
+    progress = false;
+    for (int i = 0; i < N; ++i) {
+      if (done[i] || pending[i] != 0) continue;
+      done[i] = true;
+      progress = true;
+      g.order.push_back(i);
+      for (int j = 0; j < N; ++j)
+        for (int in : g.nodes[j].inputs)
+          if (in == i) --pending[j];
+    }
+  }
+  if (static_cast<int>(g.order.size()) != N) {
+    std::vector<std::string> cyc;
+    int first = -1;
+    for (int i = 0; i < N; ++i)
+      if (!done[i]) {
+        cyc.push_back(g.nodes[i].config.id);
+        if (first < 0) first = i;
+      }
+    throw ConfigError("the graph has a cycle through: " + join(cyc, " -> ") +
+                          " (each node must come after its inputs)",
+                      g.nodes[first].config.loc, g.nodes[first].config.id);
+  }
+
+  // Plugin-side checks (segment consistency, data files) run at construction.
+  (void)instantiate(g, registry);
+  return g;
+}
+
+GraphInstance instantiate(const Graph& g, const PluginRegistry& registry) {
+  GraphInstance inst;
+  const size_t N = g.nodes.size();
+  inst.components.resize(N);
+  inst.links.resize(N);
+  for (size_t i = 0; i < N; ++i) {
+    const GraphNode& n = g.nodes[i];
+    try {
+      inst.components[i] = registry.create(*n.type, n.params);
+    } catch (const ConfigError& e) {
+      if (!e.node().empty()) throw;
+      throw ConfigError(e.what(), e.where().line ? e.where() : n.config.loc, n.config.id);
+    } catch (const std::exception& e) {
+      throw ConfigError(e.what(), n.config.loc, n.config.id);
+    }
+  }
+  for (size_t i = 0; i < N; ++i) {
+    const GraphNode& n = g.nodes[i];
+    for (size_t k = 0; k < n.inputs.size(); ++k)
+      inst.links[n.inputs[k]].push_back({inst.components[i].get(), static_cast<int>(k), n.input_kinds[k]});
+    if (n.inputs.empty() && n.type->decl.kind != ComponentKind::Adapter) {
+      if (!dynamic_cast<Generator*>(inst.components[i].get()))
+        throw ConfigError(n.config.type + " needs an input ('input: <node id>'); only sources can stand alone",
+                          n.config.loc, n.config.id);
+      inst.roots.push_back(static_cast<int>(i));
+    }
+    if (n.attach_to >= 0) {
+      auto* adapter = dynamic_cast<Adapter*>(inst.components[i].get());
+      auto* filter = dynamic_cast<Filter*>(inst.components[n.attach_to].get());
+      if (!adapter || !filter)
+        throw ConfigError("cannot attach: " + n.config.type + " is not an Adapter or its target is not a Filter",
+                          n.config.attach_loc, n.config.id);
+      if (std::string why = adapter->incompatibility(*filter); !why.empty())
+        throw ConfigError("cannot attach to '" + g.nodes[n.attach_to].config.id + "': " + why, n.config.attach_loc,
+                          n.config.id);
+      if (!filter->attach(adapter))
+        throw ConfigError("too many adapters on '" + g.nodes[n.attach_to].config.id + "'", n.config.attach_loc,
+                          n.config.id);
+    }
+  }
+  for (size_t i = 0; i < N; ++i)
+    inst.components[i]->out.connect(inst.links[i].data(), static_cast<int>(inst.links[i].size()));
+  return inst;
+}
+
+}  // namespace trackflow::host

@@ -1,0 +1,107 @@
+// Purpose: parameter declarations' builders and the typed getters of validated parameters.
+#include <trackflow/params.hpp>
+
+namespace trackflow {
+
+const char* to_string(ParamType t) {
+  switch (t) {
+    case ParamType::Real: return "real";
+    case ParamType::Integer: return "integer";
+    case ParamType::Boolean: return "boolean";
+    case ParamType::String: return "string";
+    case ParamType::Choice: return "choice";
+    case ParamType::RealList: return "list of reals";
+    case ParamType::Records: return "list of records";
+  }
+  return "?";
+}
+
+namespace {
+ParamSpec make(std::string name, ParamType t, std::string doc) {
+  ParamSpec s;
+  s.name = std::move(name);
+  s.type = t;
+  s.doc = std::move(doc);
+  return s;
+}
+}  // namespace
+
+ParamSpec ParamSpec::real(std::string name, Dimension d, std::string doc) {
+  auto s = make(std::move(name), ParamType::Real, std::move(doc));
+  s.dimension = d;
+  return s;
+}
+ParamSpec ParamSpec::integer(std::string name, std::string doc) {
+  return make(std::move(name), ParamType::Integer, std::move(doc));
+}
+ParamSpec ParamSpec::boolean(std::string name, std::string doc) {
+  return make(std::move(name), ParamType::Boolean, std::move(doc));
+}
+ParamSpec ParamSpec::string(std::string name, std::string doc) {
+  return make(std::move(name), ParamType::String, std::move(doc));
+}
+ParamSpec ParamSpec::choice(std::string name, std::vector<std::string> choices, std::string doc) {
+  auto s = make(std::move(name), ParamType::Choice, std::move(doc));
+  s.choices = std::move(choices);
+  return s;
+}
+ParamSpec ParamSpec::real_list(std::string name, Dimension d, std::string doc, int size) {
+  auto s = make(std::move(name), ParamType::RealList, std::move(doc));
+  s.dimension = d;
+  s.list_size = size;
+  return s;
+}
+ParamSpec ParamSpec::records(std::string name, std::vector<ParamSpec> fields, std::string doc) {
+  auto s = make(std::move(name), ParamType::Records, std::move(doc));
+  s.fields = std::move(fields);
+  return s;
+}
+
+const ParamValue& Params::get(std::string_view name, ParamType expected) const {
+  for (const auto& [n, v] : values_) {
+    if (n != name) continue;
+    const bool ok = v.type == expected ||
+                    (expected == ParamType::String && v.type == ParamType::Choice);
+    if (!ok)
+      throw ConfigError("parameter '" + std::string(name) + "' is a " + to_string(v.type) +
+                            ", read as a " + to_string(expected) + " (plugin bug)",
+                        v.where, node_);
+    return v;
+  }
+  throw ConfigError("parameter '" + std::string(name) + "' has no value (not declared, or optional and not given)",
+                    where_, node_);
+}
+
+double Params::real(std::string_view n) const { return get(n, ParamType::Real).real; }
+long long Params::integer(std::string_view n) const { return get(n, ParamType::Integer).integer; }
+bool Params::boolean(std::string_view n) const { return get(n, ParamType::Boolean).boolean; }
+const std::string& Params::text(std::string_view n) const { return get(n, ParamType::String).text; }
+const std::vector<double>& Params::reals(std::string_view n) const { return get(n, ParamType::RealList).reals; }
+const std::vector<Params>& Params::records(std::string_view n) const { return get(n, ParamType::Records).records; }
+
+Vec3 Params::vec3(std::string_view n) const {
+  const auto& r = reals(n);
+  if (r.size() != 3) throw error(n, "expects 3 values, got " + std::to_string(r.size()));
+  return {r[0], r[1], r[2]};
+}
+
+bool Params::has(std::string_view name) const {
+  for (const auto& [n, v] : values_)
+    if (n == name) return true;
+  return false;
+}
+bool Params::given(std::string_view name) const {
+  for (const auto& [n, v] : values_)
+    if (n == name) return !v.from_default;
+  return false;
+}
+SourceLoc Params::where(std::string_view name) const {
+  for (const auto& [n, v] : values_)
+    if (n == name && !v.from_default) return v.where;
+  return where_;
+}
+ConfigError Params::error(std::string_view name, const std::string& message) const {
+  return ConfigError("parameter '" + std::string(name) + "': " + message, where(name), node_);
+}
+
+}  // namespace trackflow

@@ -1,0 +1,152 @@
+// Purpose: plugin discovery and loading with Boost.DLL, with a staged, file-naming error for each failure.
+#include <trackflow/host/plugins.hpp>
+#include <trackflow/plugin.hpp>
+
+#include <boost/dll/shared_library.hpp>
+
+#include <dlfcn.h>
+
+#include <algorithm>
+#include <cstdlib>
+#include <filesystem>
+
+namespace fs = std::filesystem;
+
+namespace trackflow::host {
+namespace {
+
+class CollectingRegistrar : public Registrar {
+ public:
+  void add(ComponentDecl decl) override { decls.push_back(std::move(decl)); }
+  std::vector<ComponentDecl> decls;
+};
+
+std::string size_mismatch(const PluginInfo& info) {
+  const PluginInfo mine = make_plugin_info("", nullptr);
+  std::string m;
+  auto check = [&](const char* what, std::size_t theirs, std::size_t ours) {
+    if (theirs != ours)
+      m += std::string(m.empty() ? "" : ", ") + "sizeof(" + what + ") " + std::to_string(theirs) + " vs " +
+           std::to_string(ours);
+  };
+  check("Truth", info.sizeof_truth, mine.sizeof_truth);
+  check("Measurement", info.sizeof_measurement, mine.sizeof_measurement);
+  check("Estimate", info.sizeof_estimate, mine.sizeof_estimate);
+  check("Params", info.sizeof_params, mine.sizeof_params);
+  check("Component", info.sizeof_component, mine.sizeof_component);
+  return m;
+}
+
+}  // namespace
+
+void PluginRegistry::load_directories(const std::vector<std::string>& dirs) {
+  for (const auto& d : dirs) {
+    searched_.push_back(d);
+    std::error_code ec;
+    if (!fs::is_directory(d, ec)) continue;
+    std::vector<fs::path> files;
+    for (const auto& e : fs::directory_iterator(d, ec)) {
+      const auto name = e.path().filename().string();
+      if (name.rfind("tfplugin_", 0) == 0 && e.path().extension() == ".so") files.push_back(e.path());
+    }
+    std::sort(files.begin(), files.end());  // directory order is arbitrary; loading order must not be
+    for (const auto& f : files) load_file(f.string());
+  }
+}
+
+void PluginRegistry::load_file(const std::string& path) {
+  for (const auto& p : plugins_)
+    if (fs::equivalent(p.file, path)) return;
+  auto lib = std::make_shared<boost::dll::shared_library>();
+  std::error_code ec;
+  lib->load(path, boost::dll::load_mode::rtld_lazy | boost::dll::load_mode::rtld_local, ec);
+  if (ec) {
+    // Boost's error text is errno's, which is misleading here; dlerror() says what went wrong.
+    std::string why = ec.message();
+    if (void* h = ::dlopen(path.c_str(), RTLD_LAZY | RTLD_LOCAL)) {
+      ::dlclose(h);
+    } else if (const char* e = ::dlerror()) {
+      why = e;
+    }
+    problems_.push_back({path, "open", why});
+    return;
+  }
+  if (!lib->has("trackflow_plugin_v1")) {
+    problems_.push_back({path, "entry", "not a trackflow plugin: no 'trackflow_plugin_v1' entry (use TRACKFLOW_PLUGIN)"});
+    return;
+  }
+  const PluginInfo* info = lib->get_alias<const PluginInfo*()>("trackflow_plugin_v1")();
+  if (!info || info->abi_version != kAbiVersion) {
+    problems_.push_back({path, "abi",
+                         "built against plugin ABI " + std::to_string(info ? info->abi_version : -1) + " (SDK " +
+                             (info && info->sdk_version ? info->sdk_version : "?") + "); this trackflow needs ABI " +
+                             std::to_string(kAbiVersion) + " (SDK " + kSdkVersion + "): rebuild the plugin"});
+    return;
+  }
+  if (auto m = size_mismatch(*info); !m.empty()) {
+    problems_.push_back({path, "abi", "SDK types differ from this trackflow's (" + m + "): rebuild the plugin"});
+    return;
+  }
+  CollectingRegistrar reg;
+  try {
+    info->register_components(reg);
+  } catch (const std::exception& e) {
+    problems_.push_back({path, "register", std::string("registration threw: ") + e.what()});
+    return;
+  }
+  LoadedPlugin loaded{path, info->plugin_name ? info->plugin_name : "", {}};
+  for (auto& d : reg.decls) {
+    if (const RegisteredType* prev = find(d.type)) {
+      problems_.push_back({path, "register", "type '" + d.type + "' already provided by " + prev->file + " (kept that one)"});
+      continue;
+    }
+    if (!d.create) {
+      problems_.push_back({path, "register", "type '" + d.type + "' has no factory"});
+      continue;
+    }
+    loaded.types.push_back(d.type);
+    types_.push_back({lib, std::move(d), path});
+  }
+  plugins_.push_back(std::move(loaded));
+}
+
+const RegisteredType* PluginRegistry::find(const std::string& type) const {
+  for (const auto& t : types_)
+    if (t.decl.type == type) return &t;
+  return nullptr;
+}
+
+std::vector<std::string> PluginRegistry::type_names() const {
+  std::vector<std::string> names;
+  for (const auto& t : types_) names.push_back(t.decl.type);
+  std::sort(names.begin(), names.end());
+  return names;
+}
+
+std::shared_ptr<Component> PluginRegistry::create(const RegisteredType& t, const Params& p) const {
+  std::unique_ptr<Component> c = t.decl.create(p);
+  if (!c) throw ConfigError("factory of '" + t.decl.type + "' returned nothing", p.where(), p.node());
+  auto lib = t.library;
+  return std::shared_ptr<Component>(c.release(), [lib](Component* ptr) { delete ptr; });
+}
+
+std::vector<std::string> default_plugin_dirs() {
+  std::vector<std::string> dirs;
+  if (const char* env = std::getenv("TRACKFLOW_PLUGIN_PATH")) {
+    std::string s = env;
+    size_t pos = 0;
+    while (pos <= s.size()) {
+      size_t c = s.find(':', pos);
+      std::string d = s.substr(pos, c == std::string::npos ? std::string::npos : c - pos);
+      if (!d.empty()) dirs.push_back(d);
+      if (c == std::string::npos) break;
+      pos = c + 1;
+    }
+  }
+  std::error_code ec;
+  const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
+  if (!ec) dirs.push_back((exe.parent_path().parent_path() / "lib" / "trackflow" / "plugins").lexically_normal().string());
+  return dirs;
+}
+
+}  // namespace trackflow::host

@@ -1,0 +1,176 @@
+// Purpose: expect checks, the terminal summary and the metrics JSON file.
+#include <trackflow/host/report.hpp>
+#include <trackflow/host/suggest.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+namespace trackflow::host {
+namespace {
+
+std::string fmt(double v) {
+  if (!std::isfinite(v)) return std::isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf");
+  char buf[64];
+  const double a = std::fabs(v);
+  if (a != 0.0 && (a >= 1e7 || a < 1e-3))
+    std::snprintf(buf, sizeof buf, "%.4g", v);
+  else
+    std::snprintf(buf, sizeof buf, "%.4f", v);
+  std::string s = buf;
+  if (s.find('.') != std::string::npos && s.find('e') == std::string::npos) {
+    while (s.back() == '0') s.pop_back();
+    if (s.back() == '.') s.pop_back();
+  }
+  return s;
+}
+
+}  // namespace
+
+std::string json_escape(const std::string& s) {
+  std::string o;
+  for (char c : s) {
+    if (c == '"' || c == '\\') {
+      o += '\\';
+      o += c;
+    } else if (static_cast<unsigned char>(c) < 0x20) {
+      char buf[8];
+      std::snprintf(buf, sizeof buf, "\\u%04x", c);
+      o += buf;
+    } else {
+      o += c;
+    }
+  }
+  return o;
+}
+
+std::string json_number(double v) {
+  if (!std::isfinite(v)) return "null";
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+std::vector<ExpectResult> check_expects(const Graph& g, const Outcome& out) {
+  std::vector<ExpectResult> results;
+  for (const auto& e : g.config.expects) {
+    const NodeOutcome* n = out.find(e.node);
+    if (!n) {
+      std::vector<std::string> ids;
+      for (const auto& x : out.nodes) ids.push_back(x.id);
+      throw ConfigError("expect names node '" + e.node + "', which does not exist" + did_you_mean(e.node, ids), e.loc);
+    }
+    const Metric* m = n->summary.find(e.metric);
+    if (!m) {
+      std::vector<std::string> names;
+      for (const auto& x : n->summary.metrics) names.push_back(x.name);
+      throw ConfigError("expect: node '" + e.node + "' has no metric '" + e.metric + "'" +
+                            did_you_mean(e.metric, names) + "; it reports: " + (names.empty() ? "none" : join(names)),
+                        e.loc);
+    }
+    ExpectResult r{e, false, m->value, {}};
+    const std::string name = e.node + "." + e.metric + " = " + fmt(m->value);
+    if (e.op == "max") {
+      r.passed = m->value <= e.value;
+      r.text = name + " <= " + fmt(e.value);
+    } else if (e.op == "min") {
+      r.passed = m->value >= e.value;
+      r.text = name + " >= " + fmt(e.value);
+    } else if (e.op == "equals") {
+      r.passed = std::fabs(m->value - e.value) <= e.tolerance;
+      r.text = name + " == " + fmt(e.value) + " ± " + fmt(e.tolerance);
+    } else if (e.op == "within_band") {
+      if (!m->has_band)
+        throw ConfigError("expect: metric '" + e.metric + "' of '" + e.node + "' has no band; use min/max", e.loc);
+      if (std::fabs(m->confidence - e.value) > 1e-9)
+        throw ConfigError("expect asks for a " + fmt(e.value * 100) + " % band, but '" + e.node + "' computes its " +
+                              e.metric + " band at " + fmt(m->confidence * 100) + " % (set its 'confidence' param)",
+                          e.loc);
+      r.passed = m->value >= m->band_lo && m->value <= m->band_hi;
+      r.text = name + " in [" + fmt(m->band_lo) + ", " + fmt(m->band_hi) + "] (" + fmt(e.value * 100) + " % band)";
+    } else {
+      throw ConfigError("unknown expect check '" + e.op + "'", e.loc);
+    }
+    if (!std::isfinite(m->value)) r.passed = false;
+    results.push_back(std::move(r));
+  }
+  return results;
+}
+
+void print_summary(std::ostream& os, const Graph& g, const Outcome& out, unsigned threads,
+                   const std::vector<ExpectResult>& expects) {
+  const auto& c = g.config;
+  os << "pipeline " << c.name;
+  if (!c.description.empty()) os << ": " << c.description;
+  os << "\n  " << out.runs << (out.runs == 1 ? " run" : " runs") << ", " << threads
+     << (threads == 1 ? " thread" : " threads") << ", seed " << c.seed << "; " << out.source_items
+     << " source items in " << fmt(out.seconds) << " s";
+  if (out.seconds > 0) os << " (" << fmt(std::round(out.source_items / out.seconds)) << " items/s)";
+  os << "\n";
+  for (const auto& n : out.nodes) {
+    const bool has_any = !n.summary.metrics.empty() || !n.summary.notes.empty() || n.skips > 0 || !n.summary.files.empty();
+    if (!has_any) continue;
+    os << "\n" << n.id << " (" << n.type << ")\n";
+    size_t w = 6;
+    for (const auto& m : n.summary.metrics) w = std::max(w, m.name.size() + (m.unit.empty() ? 0 : m.unit.size() + 3));
+    for (const auto& m : n.summary.metrics) {
+      std::string label = m.name + (m.unit.empty() ? "" : " [" + m.unit + "]");
+      os << "  " << std::left << std::setw(static_cast<int>(w) + 2) << label << std::right << std::setw(12) << fmt(m.value);
+      if (m.has_band) {
+        const bool in = m.value >= m.band_lo && m.value <= m.band_hi;
+        os << "   " << fmt(m.confidence * 100) << " % band [" << fmt(m.band_lo) << ", " << fmt(m.band_hi) << "] "
+           << (in ? "inside" : "OUTSIDE");
+      }
+      os << "\n";
+    }
+    if (n.skips > 0) {
+      os << "  skipped: " << n.skips << "\n";
+      for (const auto& s : n.skip_examples) os << "    " << s << "\n";
+      if (n.skips > n.skip_examples.size()) os << "    ...\n";
+    }
+    for (const auto& s : n.summary.notes) os << "  " << s << "\n";
+    for (const auto& f : n.summary.files) os << "  wrote " << f << "\n";
+  }
+  for (const auto& w : out.warnings) os << "warning: " << w << "\n";
+  if (!expects.empty()) {
+    size_t failed = 0;
+    os << "\nexpect\n";
+    for (const auto& r : expects) {
+      os << "  " << (r.passed ? "pass  " : "FAIL  ") << r.text << "   (" << r.expect.loc.str() << ")\n";
+      failed += r.passed ? 0 : 1;
+    }
+    os << "  " << expects.size() - failed << " passed, " << failed << " failed\n";
+  }
+}
+
+void write_metrics_json(const std::string& path, const Outcome& out) {
+  std::ofstream f(path);
+  if (!f) throw ConfigError("cannot write metrics JSON '" + path + "'");
+  f << "{";
+  bool first_node = true;
+  for (const auto& n : out.nodes) {
+    if (n.summary.metrics.empty() && n.skips == 0) continue;
+    f << (first_node ? "\n" : ",\n") << "  \"" << json_escape(n.id) << "\": {";
+    first_node = false;
+    bool first = true;
+    auto put = [&](const std::string& k, double v) {
+      f << (first ? "\n" : ",\n") << "    \"" << json_escape(k) << "\": " << json_number(v);
+      first = false;
+    };
+    for (const auto& m : n.summary.metrics) {
+      put(m.name, m.value);
+      if (m.has_band) {
+        put(m.name + "_band_lo", m.band_lo);
+        put(m.name + "_band_hi", m.band_hi);
+      }
+    }
+    if (n.skips > 0) put("skipped", static_cast<double>(n.skips));
+    f << "\n  }";
+  }
+  f << "\n}\n";
+  if (!f) throw ConfigError("error writing metrics JSON '" + path + "'");
+}
+
+}  // namespace trackflow::host

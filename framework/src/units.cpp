@@ -1,0 +1,128 @@
+// Purpose: parsing of quantities with units into SI values and dimensions.
+#include <trackflow/units.hpp>
+
+#include <cctype>
+#include <charconv>
+#include <cmath>
+#include <numbers>
+#include <stdexcept>
+#include <string>
+
+namespace trackflow {
+namespace {
+
+struct BaseUnit {
+  const char* name;
+  double scale;
+  Dimension dimension;
+};
+
+constexpr double kDeg = std::numbers::pi / 180.0;
+const BaseUnit kUnits[] = {
+    {"m", 1.0, dim::length},          {"km", 1e3, dim::length},       {"cm", 1e-2, dim::length},
+    {"mm", 1e-3, dim::length},        {"um", 1e-6, dim::length},      {"nmi", 1852.0, dim::length},
+    {"ft", 0.3048, dim::length},      {"s", 1.0, dim::time},          {"ms", 1e-3, dim::time},
+    {"us", 1e-6, dim::time},          {"min", 60.0, dim::time},       {"h", 3600.0, dim::time},
+    {"rad", 1.0, dim::angle},         {"mrad", 1e-3, dim::angle},     {"urad", 1e-6, dim::angle},
+    {"µrad", 1e-6, dim::angle},       {"deg", kDeg, dim::angle},      {"arcmin", kDeg / 60, dim::angle},
+    {"arcsec", kDeg / 3600, dim::angle}, {"Hz", 1.0, dim::frequency}, {"kHz", 1e3, dim::frequency},
+    {"MHz", 1e6, dim::frequency},     {"GHz", 1e9, dim::frequency},   {"dB", 1.0, dim::decibel},
+};
+
+std::string trim(std::string_view s) {
+  size_t a = 0, b = s.size();
+  while (a < b && std::isspace(static_cast<unsigned char>(s[a]))) ++a;
+  while (b > a && std::isspace(static_cast<unsigned char>(s[b - 1]))) --b;
+  return std::string(s.substr(a, b - a));
+}
+
+// One factor such as "m", "s2", "s^3", "km".
+Unit parse_factor(const std::string& f) {
+  size_t end = f.size();
+  while (end > 0 && std::isdigit(static_cast<unsigned char>(f[end - 1]))) --end;
+  std::string name = f.substr(0, end);
+  int power = 1;
+  if (end < f.size()) power = std::stoi(f.substr(end));
+  if (!name.empty() && name.back() == '^') name.pop_back();
+  for (const auto& u : kUnits) {
+    if (name == u.name) return {std::pow(u.scale, power), u.dimension.pow(power)};
+  }
+  std::string known;
+  for (const auto& u : kUnits) known += std::string(known.empty() ? "" : " ") + u.name;
+  throw std::invalid_argument("unknown unit '" + f + "' (known: " + known + ", combined with / and powers, e.g. m/s2)");
+}
+
+}  // namespace
+
+std::string Dimension::str() const {
+  if (dimensionless()) return "1";
+  std::string num, den;
+  auto part = [&](const char* sym, int e) {
+    if (e == 0) return;
+    std::string& s = e > 0 ? num : den;
+    if (!s.empty()) s += "*";
+    s += sym;
+    if (std::abs(e) != 1) s += std::to_string(std::abs(e));
+  };
+  part("m", length);
+  part("rad", angle);
+  part("dB", decibel);
+  part("s", time);
+  if (num.empty()) num = "1";
+  return den.empty() ? num : num + "/" + den;
+}
+
+Unit parse_unit(std::string_view text) {
+  const std::string s = trim(text);
+  if (s.empty()) return {};
+  Unit result;
+  size_t pos = 0;
+  bool divide = false;
+  while (pos <= s.size()) {
+    size_t next = s.find_first_of("/*", pos);
+    std::string factor = trim(s.substr(pos, next == std::string::npos ? std::string::npos : next - pos));
+    if (factor.empty()) throw std::invalid_argument("malformed unit '" + s + "'");
+    if (factor != "1") {
+      Unit u = parse_factor(factor);
+      if (divide) {
+        result.scale /= u.scale;
+        result.dimension = result.dimension * u.dimension.pow(-1);
+      } else {
+        result.scale *= u.scale;
+        result.dimension = result.dimension * u.dimension;
+      }
+    }
+    if (next == std::string::npos) break;
+    divide = s[next] == '/';
+    pos = next + 1;
+  }
+  return result;
+}
+
+Quantity parse_quantity(std::string_view text) {
+  const std::string s = trim(text);
+  if (s.empty()) throw std::invalid_argument("empty value");
+  double v = 0.0;
+  const char* first = s.data();
+  const char* last = s.data() + s.size();
+  auto [ptr, ec] = std::from_chars(first, last, v);
+  if (ec != std::errc()) {
+    // from_chars rejects a leading '+'
+    if (s[0] == '+') return parse_quantity(s.substr(1));
+    throw std::invalid_argument("'" + s + "' is not a number");
+  }
+  if (!std::isfinite(v)) throw std::invalid_argument("'" + s + "' is not a finite number");
+  Quantity q;
+  const std::string rest = trim(std::string_view(ptr, static_cast<size_t>(last - ptr)));
+  if (rest.empty()) {
+    q.value = v;
+    return q;
+  }
+  const Unit u = parse_unit(rest);
+  q.value = v * u.scale;
+  q.dimension = u.dimension;
+  q.had_unit = true;
+  return q;
+}
+
+}  // namespace trackflow

@@ -1,0 +1,157 @@
+// Purpose: validation of node parameters against their declarations (type, unit dimension, range).
+#include <trackflow/host/suggest.hpp>
+#include <trackflow/host/validate.hpp>
+
+#include <algorithm>
+#include <cmath>
+#include <sstream>
+
+namespace trackflow::host {
+namespace {
+
+std::string fmt_si(double v) {
+  std::ostringstream o;
+  o << v;
+  return o.str();
+}
+
+double parse_real(const ParamSpec& s, const Value& v, const std::string& node) {
+  if (!v.is_scalar())
+    throw ConfigError("parameter '" + s.name + "' expects a " + describe_type(s) + ", got " + v.describe(), v.loc,
+                      node);
+  Quantity q;
+  try {
+    q = parse_quantity(v.scalar);
+  } catch (const std::exception& e) {
+    throw ConfigError("parameter '" + s.name + "': " + e.what(), v.loc, node);
+  }
+  if (q.had_unit && q.dimension != s.dimension)
+    throw ConfigError("parameter '" + s.name + "' has unit dimension " + s.dimension.str() + ", but '" + v.scalar +
+                          "' is " + q.dimension.str(),
+                      v.loc, node);
+  if (q.value < s.min || q.value > s.max) {
+    std::string range;
+    if (std::isfinite(s.min) && std::isfinite(s.max))
+      range = "between " + fmt_si(s.min) + " and " + fmt_si(s.max);
+    else if (std::isfinite(s.min))
+      range = s.min > 0 && s.min < 1e-300 ? std::string("positive") : "at least " + fmt_si(s.min);
+    else
+      range = "at most " + fmt_si(s.max);
+    throw ConfigError("parameter '" + s.name + "' must be " + range + " " + s.dimension.str() + ", got '" + v.scalar +
+                          "'",
+                      v.loc, node);
+  }
+  return q.value;
+}
+
+ParamValue parse_value(const ParamSpec& s, const Value& v, const std::string& node) {
+  ParamValue out;
+  out.type = s.type;
+  out.where = v.loc;
+  auto type_error = [&]() {
+    return ConfigError("parameter '" + s.name + "' expects a " + describe_type(s) + ", got " + v.describe(), v.loc,
+                       node);
+  };
+  switch (s.type) {
+    case ParamType::Real:
+      out.real = parse_real(s, v, node);
+      break;
+    case ParamType::Integer: {
+      if (!v.is_scalar()) throw type_error();
+      try {
+        size_t used = 0;
+        out.integer = std::stoll(v.scalar, &used);
+        if (used != v.scalar.size()) throw type_error();
+      } catch (const std::logic_error&) {
+        throw type_error();
+      }
+      if (out.integer < s.min || out.integer > s.max) throw ConfigError("parameter '" + s.name + "' out of range", v.loc, node);
+      break;
+    }
+    case ParamType::Boolean:
+      if (!v.is_scalar()) throw type_error();
+      if (v.scalar == "true" || v.scalar == "yes" || v.scalar == "on")
+        out.boolean = true;
+      else if (v.scalar == "false" || v.scalar == "no" || v.scalar == "off")
+        out.boolean = false;
+      else
+        throw type_error();
+      break;
+    case ParamType::String:
+      if (!v.is_scalar()) throw type_error();
+      out.text = v.scalar;
+      break;
+    case ParamType::Choice:
+      if (!v.is_scalar()) throw type_error();
+      if (std::find(s.choices.begin(), s.choices.end(), v.scalar) == s.choices.end())
+        throw ConfigError("parameter '" + s.name + "' must be one of " + join(s.choices, ", ") + "; got '" + v.scalar +
+                              "'" + did_you_mean(v.scalar, s.choices),
+                          v.loc, node);
+      out.text = v.scalar;
+      break;
+    case ParamType::RealList: {
+      if (v.kind != Value::Kind::List) throw type_error();
+      if (s.list_size >= 0 && static_cast<int>(v.items.size()) != s.list_size)
+        throw ConfigError("parameter '" + s.name + "' expects " + std::to_string(s.list_size) + " values, got " +
+                              std::to_string(v.items.size()),
+                          v.loc, node);
+      ParamSpec elem = s;
+      elem.type = ParamType::Real;
+      for (const auto& item : v.items) out.reals.push_back(parse_real(elem, item, node));
+      break;
+    }
+    case ParamType::Records: {
+      if (v.kind != Value::Kind::List) throw type_error();
+      for (const auto& item : v.items) {
+        if (item.kind != Value::Kind::Map)
+          throw ConfigError("each entry of '" + s.name + "' must be a map, got " + item.describe(), item.loc, node);
+        out.records.push_back(validate_params(s.fields, item, node, item.loc));
+      }
+      break;
+    }
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string describe_type(const ParamSpec& s) {
+  switch (s.type) {
+    case ParamType::Real: return "real [" + s.dimension.str() + "]";
+    case ParamType::RealList:
+      return (s.list_size >= 0 ? "list of " + std::to_string(s.list_size) : std::string("list of")) + " reals [" +
+             s.dimension.str() + "]";
+    case ParamType::Choice: return "choice {" + join(s.choices, "|") + "}";
+    default: return to_string(s.type);
+  }
+}
+
+Params validate_params(const std::vector<ParamSpec>& specs, const Value& given, const std::string& node,
+                       const SourceLoc& node_loc) {
+  Params p(node, given.kind == Value::Kind::Null ? node_loc : given.loc);
+  std::vector<std::string> names;
+  for (const auto& s : specs) names.push_back(s.name);
+  for (size_t i = 0; i < given.entries.size(); ++i) {
+    const auto& key = given.entries[i].first;
+    if (std::find(names.begin(), names.end(), key) == names.end())
+      throw ConfigError("unknown parameter '" + key + "'" + did_you_mean(key, names) +
+                            (names.empty() ? "; this type takes no parameters" : "; known: " + join(names)),
+                        given.key_locs[i], node);
+  }
+  for (const auto& s : specs) {
+    if (const Value* v = given.find(s.name)) {
+      p.set(s.name, parse_value(s, *v, node));
+    } else if (!s.default_text.empty()) {
+      Value dv = load_yaml_string(s.default_text, "default of " + s.name);
+      ParamValue pv = parse_value(s, dv, node);
+      pv.from_default = true;
+      p.set(s.name, std::move(pv));
+    } else if (s.required) {
+      throw ConfigError("missing required parameter '" + s.name + "' (" + describe_type(s) + ": " + s.doc + ")",
+                        given.kind == Value::Kind::Null ? node_loc : given.loc, node);
+    }
+  }
+  return p;
+}
+
+}  // namespace trackflow::host

@@ -1,0 +1,91 @@
+// Purpose: tests of pipeline parsing and parameter validation (positions, suggestions, units).
+#include <trackflow/host/config.hpp>
+#include <trackflow/host/validate.hpp>
+
+#include <catch2/catch.hpp>
+
+using namespace trackflow;
+using namespace trackflow::host;
+
+namespace {
+std::vector<ParamSpec> specs() {
+  return {ParamSpec::real("sigma_range", dim::length, "range noise").def("10 m").at_least(0),
+          ParamSpec::real("rate", dim::frequency, "sample rate").req().positive(),
+          ParamSpec::choice("mode", {"skin", "beacon"}, "track mode").def("skin"),
+          ParamSpec::real_list("position", dim::length, "sensor position", 3).def("[0, 0, 0]")};
+}
+ConfigError validate_error(const std::string& yaml) {
+  Value v = load_yaml_string(yaml, "p.yaml");
+  try {
+    validate_params(specs(), v, "radar", v.loc);
+  } catch (const ConfigError& e) {
+    return e;
+  }
+  FAIL("no error for: " << yaml);
+  return ConfigError("");
+}
+}  // namespace
+
+TEST_CASE("valid parameters come out in SI, defaults filled") {
+  Value v = load_yaml_string("{ rate: 40 Hz, position: [1 km, 0, -2] }", "p.yaml");
+  Params p = validate_params(specs(), v, "radar", v.loc);
+  CHECK(p.real("rate") == 40.0);
+  CHECK(p.real("sigma_range") == 10.0);
+  CHECK_FALSE(p.given("sigma_range"));
+  CHECK(p.given("rate"));
+  CHECK(p.text("mode") == "skin");
+  CHECK(p.vec3("position")(0) == 1000.0);
+}
+
+TEST_CASE("parameter errors name the line, column and node") {
+  auto e = validate_error("rate: 40 Hz\nsigma_rnge: 3 m\n");
+  CHECK(e.message().find("p.yaml:2:1") != std::string::npos);
+  CHECK(e.message().find("node 'radar'") != std::string::npos);
+  CHECK(e.message().find("did you mean 'sigma_range'") != std::string::npos);
+
+  e = validate_error("rate: 40 Hz\nsigma_range: 3 mrad\n");
+  CHECK(e.message().find("p.yaml:2:14") != std::string::npos);
+  CHECK(e.message().find("dimension m") != std::string::npos);
+
+  e = validate_error("sigma_range: 3 m\n");
+  CHECK(e.message().find("missing required parameter 'rate'") != std::string::npos);
+
+  e = validate_error("rate: fast\n");
+  CHECK(e.message().find("not a number") != std::string::npos);
+
+  e = validate_error("rate: 40 Hz\nmode: skn\n");
+  CHECK(e.message().find("did you mean 'skin'") != std::string::npos);
+
+  e = validate_error("rate: 40 Hz\nposition: [1, 2]\n");
+  CHECK(e.message().find("expects 3 values") != std::string::npos);
+
+  e = validate_error("rate: -1 Hz\n");
+  CHECK(e.message().find("positive") != std::string::npos);
+}
+
+TEST_CASE("pipeline structure errors") {
+  auto err = [](const std::string& yaml) -> std::string {
+    try {
+      parse_pipeline(load_yaml_string(yaml, "p.yaml"), "p.yaml");
+    } catch (const ConfigError& e) {
+      return e.message();
+    }
+    return "no error";
+  };
+  CHECK(err("pipeline: {name: a}\nnodes:\n  - {id: a, type: x}\n  - {id: a, type: y}\n").find("duplicate node id 'a'") !=
+        std::string::npos);
+  CHECK(err("pipeline: {name: a}\nnodes: []\n").find("non-empty") != std::string::npos);
+  CHECK(err("pipeline: {name: a}\nnode:\n  - {id: a, type: x}\n").find("did you mean 'nodes'") != std::string::npos);
+  CHECK(err("pipeline: {name: a}\nnodes:\n  - {id: a, type: x, inptu: b}\n").find("p.yaml:3:") != std::string::npos);
+  CHECK(err("pipeline: {name: a, runs: many}\nnodes:\n  - {id: a, type: x}\n").find("whole number") != std::string::npos);
+}
+
+TEST_CASE("overrides from the command line replace or add parameters") {
+  Value v = load_yaml_string("pipeline: {name: a}\nnodes:\n  - id: kf\n    type: filter.kalman\n    params: { q: 1 }\n",
+                             "p.yaml");
+  auto cfg = parse_pipeline(v, "p.yaml", {parse_override("kf.q=4"), parse_override("kf.r=\"20 m\"")});
+  CHECK(cfg.nodes[0].params.find("q")->scalar == "4");
+  CHECK(cfg.nodes[0].params.find("r")->scalar == "20 m");
+  CHECK_THROWS_WITH(parse_pipeline(v, "p.yaml", {parse_override("kff.q=4")}), Catch::Contains("did you mean 'kf'"));
+  CHECK_THROWS_AS(parse_override("kfq4"), ConfigError);
+}

@@ -1,0 +1,83 @@
+// Purpose: tests of angle wrapping, spherical geometry, motion models and the Joseph update.
+#include <trackflow/geometry.hpp>
+#include <trackflow/kalman.hpp>
+#include <trackflow/motion.hpp>
+
+#include <Eigen/Dense>
+
+#include <catch2/catch.hpp>
+
+#include <numbers>
+
+using namespace trackflow;
+constexpr double pi = std::numbers::pi;
+
+TEST_CASE("wrap_angle maps to (-pi, pi]") {
+  CHECK(wrap_angle(pi) == Approx(pi));
+  CHECK(wrap_angle(-pi) == Approx(pi));
+  CHECK(wrap_angle(3 * pi / 2) == Approx(-pi / 2));
+  CHECK(wrap_angle(-3 * pi / 2) == Approx(pi / 2));
+  CHECK(wrap_angle(0.1 + 20 * pi) == Approx(0.1));
+  CHECK(wrap_angle(pi - 1e-12) - (-pi + 1e-12) > 0);  // no jump inside the range
+}
+
+TEST_CASE("spherical round trip in both conventions, and at the zenith") {
+  for (auto c : {AzimuthConvention::NorthClockwise, AzimuthConvention::XCounterClockwise}) {
+    const Vec3 s(12e3, -2.9, 0.3);
+    const Vec3 back = enu_to_spherical(spherical_to_enu(s(0), s(1), s(2), c), c);
+    CHECK(back(0) == Approx(s(0)));
+    CHECK(back(1) == Approx(s(1)));
+    CHECK(back(2) == Approx(s(2)));
+  }
+  const Vec3 z = enu_to_spherical(Vec3(0, 0, 1000), AzimuthConvention::NorthClockwise);
+  CHECK(z(0) == Approx(1000));
+  CHECK(z(2) == Approx(pi / 2));
+  CHECK(std::isfinite(z(1)));
+  const Vec3 o = enu_to_spherical(Vec3::Zero(), AzimuthConvention::NorthClockwise);
+  CHECK(o.allFinite());
+}
+
+TEST_CASE("continuous-noise Q of CA is the white-jerk matrix of paper 000 eq 3.19") {
+  const double T = 0.025, q = 2.0;
+  const auto Q = ConstantAcceleration::axis_noise_continuous(T, q);
+  CHECK(Q(0, 0) == Approx(q * std::pow(T, 5) / 20));
+  CHECK(Q(0, 1) == Approx(q * std::pow(T, 4) / 8));
+  CHECK(Q(0, 2) == Approx(q * std::pow(T, 3) / 6));
+  CHECK(Q(1, 1) == Approx(q * std::pow(T, 3) / 3));
+  CHECK(Q(2, 2) == Approx(q * T));
+  CHECK((Q - Q.transpose()).norm() == 0.0);
+  const auto Qv = ConstantVelocity::axis_noise_continuous(T, q);
+  CHECK(Qv(0, 0) == Approx(q * T * T * T / 3));
+  CHECK(Qv(0, 1) == Approx(q * T * T / 2));
+}
+
+TEST_CASE("propagate equals F x") {
+  ConstantAcceleration::State x;
+  x << 1, 2, 3, 4, 5, 6, 7, 8, 9;
+  ConstantAcceleration::Matrix F;
+  ConstantAcceleration::transition(0.5, F);
+  const ConstantAcceleration::State expected = F * x;
+  ConstantAcceleration::propagate(0.5, x);
+  CHECK((x - expected).norm() < 1e-12);
+}
+
+TEST_CASE("Joseph update keeps P symmetric positive definite and matches the textbook gain") {
+  using M = ConstantVelocity;
+  M::State x = M::State::Zero();
+  M::Matrix P = M::Matrix::Identity() * 100.0;
+  P(0, 1) = P(1, 0) = 5.0;
+  Eigen::Matrix<double, 3, 6> H = Eigen::Matrix<double, 3, 6>::Zero();
+  for (int a = 0; a < 3; ++a) H(a, M::position_index(a)) = 1.0;
+  const Eigen::Matrix3d R = Eigen::Matrix3d::Identity() * 4.0;
+  Eigen::Vector3d nu(1, 2, 3);
+  Eigen::Matrix3d S;
+  double nis = 0;
+  const M::Matrix P0 = P;
+  REQUIRE(joseph_update<6, 3>(x, P, nu, H, R, S, nis));
+  const Eigen::Matrix<double, 6, 3> K = P0 * H.transpose() * (H * P0 * H.transpose() + R).inverse();
+  CHECK((x - K * nu).norm() < 1e-10);
+  CHECK((P - (M::Matrix::Identity() - K * H) * P0).norm() < 1e-9);
+  CHECK((P - P.transpose()).norm() == 0.0);
+  CHECK(Eigen::LLT<M::Matrix>(P).info() == Eigen::Success);
+  CHECK(nis == Approx(nu.dot(S.inverse() * nu)));
+}
