@@ -163,6 +163,14 @@ GraphInstance instantiate(const Graph& g, const PluginRegistry& registry) {
   }
   for (size_t i = 0; i < N; ++i) {
     const GraphNode& n = g.nodes[i];
+    std::vector<InputInfo> infos;
+    for (size_t k = 0; k < n.inputs.size(); ++k)
+      infos.push_back({g.nodes[n.inputs[k]].config.id, g.nodes[n.inputs[k]].config.type, n.input_kinds[k]});
+    try {
+      inst.components[i]->set_inputs(infos);
+    } catch (const ConfigError& e) {
+      throw ConfigError(e.what(), e.where().line ? e.where() : n.config.loc, n.config.id);
+    }
     for (size_t k = 0; k < n.inputs.size(); ++k)
       inst.links[n.inputs[k]].push_back({inst.components[i].get(), static_cast<int>(k), n.input_kinds[k]});
     if (n.inputs.empty() && n.type->decl.kind != ComponentKind::Adapter) {

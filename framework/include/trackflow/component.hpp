@@ -71,6 +71,13 @@ struct Summary {
   }
 };
 
+// One input of a node as wired in the pipeline (port = position in `inputs:`).
+struct InputInfo {
+  std::string node;   // upstream node id
+  std::string type;   // upstream component type
+  ItemMask kinds = 0; // item kinds this input delivers
+};
+
 struct FinishContext {
   std::string node;
   std::string output_dir;   // --out, created on demand by the component that writes
@@ -99,6 +106,9 @@ class Outputs {
 class BOOST_SYMBOL_VISIBLE Component {
  public:
   virtual ~Component() = default;
+  // Called once after construction with this node's inputs; may throw ConfigError (e.g. a
+  // sink that takes at most one estimate stream).
+  virtual void set_inputs(const std::vector<InputInfo>&) {}
   virtual void start_run(const RunContext&) {}
   // Items arriving on input `port` (the position of the source in the node's `inputs:`).
   virtual void on_truth(const Truth&, int port);
