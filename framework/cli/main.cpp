@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <filesystem>
+#include <iomanip>
 #include <iostream>
 #include <sstream>
 #include <thread>
@@ -236,8 +237,8 @@ void describe_params(std::ostream& os, const std::vector<ParamSpec>& ps, const s
     if (md) {
       os << indent << "| `" << p.name << "` | " << describe_type(p) << " | " << def << " | " << p.doc << " |\n";
     } else {
-      os << indent << std::left << std::setw(22) << p.name << std::setw(26) << describe_type(p) << std::setw(18) << def
-         << p.doc << "\n";
+      os << indent << std::left << std::setw(22) << p.name << " " << std::setw(26) << describe_type(p) << " "
+         << std::setw(18) << def << " " << p.doc << "\n";
     }
     if (p.type == ParamType::Records) {
       if (md) {

@@ -37,6 +37,14 @@ std::string size_mismatch(const PluginInfo& info) {
   return m;
 }
 
+// Loaded libraries are never unloaded before the process exits (Boost.DLL FAQ): exception
+// objects, type_info and static destructors from a plugin may outlive every registry and
+// component, e.g. a ConfigError thrown by a factory and caught in main().
+void keep_loaded(std::shared_ptr<boost::dll::shared_library> lib) {
+  static auto* libraries = new std::vector<std::shared_ptr<boost::dll::shared_library>>();
+  libraries->push_back(std::move(lib));
+}
+
 }  // namespace
 
 void PluginRegistry::load_directories(const std::vector<std::string>& dirs) {
@@ -71,6 +79,7 @@ void PluginRegistry::load_file(const std::string& path) {
     problems_.push_back({path, "open", why});
     return;
   }
+  keep_loaded(lib);
   if (!lib->has("trackflow_plugin_v1")) {
     problems_.push_back({path, "entry", "not a trackflow plugin: no 'trackflow_plugin_v1' entry (use TRACKFLOW_PLUGIN)"});
     return;
@@ -145,7 +154,14 @@ std::vector<std::string> default_plugin_dirs() {
   }
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
-  if (!ec) dirs.push_back((exe.parent_path().parent_path() / "lib" / "trackflow" / "plugins").lexically_normal().string());
+  if (!ec) {
+    // Build tree and installs with libdir "lib" use lib/trackflow/plugins; Debian-style
+    // multiarch installs use the configured CMAKE_INSTALL_LIBDIR.
+    const fs::path prefix = exe.parent_path().parent_path();
+    dirs.push_back((prefix / "lib" / "trackflow" / "plugins").lexically_normal().string());
+    const fs::path installed = (prefix / TRACKFLOW_INSTALL_PLUGIN_RELDIR).lexically_normal();
+    if (installed.string() != dirs.back()) dirs.push_back(installed.string());
+  }
   return dirs;
 }
 

@@ -1,0 +1,180 @@
+// Purpose: tests of filter.kalman against a textbook reference filter, for consistency (NEES), coasting and errors.
+#include <trackflow/rng.hpp>
+
+#include <Eigen/Dense>
+#include <catch2/catch.hpp>
+
+#include "plugin_fixture.hpp"
+
+using namespace trackflow;
+
+namespace {
+
+Measurement cartesian(double t, const Vec3& z, double sigma) {
+  Measurement m;
+  m.time = t;
+  m.frame = Frame::Cartesian;
+  m.value = z;
+  m.covariance = MeasCov::Identity(3, 3) * sigma * sigma;
+  return m;
+}
+
+// Plain textbook KF (dynamic sizes, standard covariance update), CV, per-axis interleaved state.
+struct ReferenceKf {
+  Eigen::VectorXd x;
+  Eigen::MatrixXd P;
+  double q;
+  void predict(double T) {
+    Eigen::MatrixXd F = Eigen::MatrixXd::Identity(6, 6), Q = Eigen::MatrixXd::Zero(6, 6);
+    for (int a = 0; a < 3; ++a) {
+      F(2 * a, 2 * a + 1) = T;
+      Q(2 * a, 2 * a) = q * T * T * T / 3;
+      Q(2 * a, 2 * a + 1) = Q(2 * a + 1, 2 * a) = q * T * T / 2;
+      Q(2 * a + 1, 2 * a + 1) = q * T;
+    }
+    x = F * x;
+    P = F * P * F.transpose() + Q;
+  }
+  void update(const Eigen::Vector3d& z, const Eigen::Matrix3d& R) {
+    Eigen::MatrixXd H = Eigen::MatrixXd::Zero(3, 6);
+    for (int a = 0; a < 3; ++a) H(a, 2 * a) = 1;
+    const Eigen::MatrixXd S = H * P * H.transpose() + R;
+    const Eigen::MatrixXd K = P * H.transpose() * S.inverse();
+    x = x + K * (z - H * x);
+    P = (Eigen::MatrixXd::Identity(6, 6) - K * H) * P;
+  }
+};
+
+}  // namespace
+
+TEST_CASE("CV filter agrees with a textbook Kalman filter step by step") {
+  auto kf = test::make("filter.kalman", "{ motion: constant_velocity, q: 2 m2/s3 }");
+  test::Collector out;
+  out.attach_to(*kf);
+  Diagnostics d;
+  kf->start_run({0, 1, &d});
+  Rng rng(7);
+  const double sigma = 5.0, T = 0.1;
+  std::vector<Measurement> ms;
+  for (int k = 0; k < 60; ++k) {
+    const double t = k * T;
+    const Vec3 truth(1000 + 50 * t, -200 + 10 * t, 300 - 3 * t);
+    ms.push_back(cartesian(t, truth + Vec3(rng.normal(), rng.normal(), rng.normal()) * sigma, sigma));
+    kf->on_measurement(ms.back(), 0);
+  }
+  REQUIRE(out.estimates.size() == 60);
+  CHECK_FALSE(out.estimates[0].initialised);
+  REQUIRE(out.estimates[1].initialised);
+  // Reference initialised from the same two points.
+  ReferenceKf ref;
+  ref.q = 2.0;
+  ref.x = Eigen::VectorXd::Zero(6);
+  ref.P = Eigen::MatrixXd::Zero(6, 6);
+  const double s2 = sigma * sigma;
+  for (int a = 0; a < 3; ++a) {
+    ref.x(2 * a) = ms[1].value(a);
+    ref.x(2 * a + 1) = (ms[1].value(a) - ms[0].value(a)) / T;
+    ref.P(2 * a, 2 * a) = s2;
+    ref.P(2 * a, 2 * a + 1) = ref.P(2 * a + 1, 2 * a) = s2 / T;
+    ref.P(2 * a + 1, 2 * a + 1) = 2 * s2 / (T * T);
+  }
+  for (size_t k = 2; k < ms.size(); ++k) {
+    ref.predict(T);
+    ref.update(ms[k].value.head<3>(), ms[k].covariance.topLeftCorner(3, 3));
+    const auto& e = out.estimates[k];
+    CHECK((e.state - ref.x).norm() < 1e-8 * ref.x.norm());
+    CHECK((e.covariance - ref.P).norm() < 1e-8 * ref.P.norm());
+  }
+  const auto& last = out.estimates.back();
+  CHECK(last.updated);
+  CHECK((last.covariance - last.covariance.transpose()).norm() == 0.0);
+  CHECK(last.enu(0) == last.state(0));
+  CHECK(last.enu(3) == last.state(1));  // vx sits at index 1 of the interleaved state
+}
+
+TEST_CASE("NEES of the CV filter on a CV target is consistent over 300 runs") {
+  const int runs = 300, steps = 40;
+  const double sigma = 10.0, T = 0.5;
+  double nees_sum = 0;
+  int count = 0;
+  auto kf = test::make("filter.kalman", "{ q: 0.01 m2/s3 }");
+  test::Collector out;
+  out.attach_to(*kf);
+  for (int r = 0; r < runs; ++r) {
+    Diagnostics d;
+    out.estimates.clear();
+    kf->start_run({static_cast<std::uint64_t>(r), 1, &d});
+    Rng rng(derive_seed(3, r, "test"));
+    Vec3 p(5000, 2000, 1000), v(-100, 30, 0);
+    for (int k = 0; k < steps; ++k) {
+      // Truth with the same white-acceleration statistics the filter assumes (q * T per step in velocity).
+      kf->on_measurement(cartesian(k * T, p + Vec3(rng.normal(), rng.normal(), rng.normal()) * sigma, sigma), 0);
+      const auto& e = out.estimates.back();
+      if (k == steps - 1) {
+        Vec6 err;
+        err << e.enu.head<3>() - p, e.enu.tail<3>() - v;
+        nees_sum += err.dot(e.enu_covariance.ldlt().solve(err));
+        ++count;
+      }
+      // Exact discretisation of continuous white acceleration with PSD q: sample w ~ N(0, Q_axis).
+      const Eigen::Matrix2d Qa = (Eigen::Matrix2d() << 0.01 * T * T * T / 3, 0.01 * T * T / 2, 0.01 * T * T / 2,
+                                  0.01 * T).finished();
+      const Eigen::Matrix2d L = Qa.llt().matrixL();
+      for (int a = 0; a < 3; ++a) {
+        const Eigen::Vector2d w = L * Eigen::Vector2d(rng.normal(), rng.normal());
+        p(a) += v(a) * T + w(0);
+        v(a) += w(1);
+      }
+    }
+  }
+  const double anees = nees_sum / (6.0 * count);
+  // chi-square(6*300) 99 % band divided by 1800: [0.922, 1.081]
+  CHECK(anees > 0.92);
+  CHECK(anees < 1.08);
+}
+
+TEST_CASE("an invalid measurement makes the filter coast: prediction only, covariance grows") {
+  auto kf = test::make("filter.kalman");
+  test::Collector out;
+  out.attach_to(*kf);
+  Diagnostics d;
+  kf->start_run({0, 1, &d});
+  for (int k = 0; k < 5; ++k) kf->on_measurement(cartesian(k, Vec3(100.0 * k, 0, 0), 3.0), 0);
+  Measurement bad = cartesian(5, Vec3(1e9, 1e9, 1e9), 3.0);
+  bad.valid = false;
+  kf->on_measurement(bad, 0);
+  REQUIRE(out.estimates.size() == 6);
+  const auto& coast = out.estimates.back();
+  CHECK_FALSE(coast.updated);
+  CHECK(coast.initialised);
+  CHECK(coast.enu(0) == Approx(500).epsilon(0.01));
+  CHECK(coast.enu_covariance(0, 0) > out.estimates[4].enu_covariance(0, 0));
+}
+
+TEST_CASE("constant-acceleration model tracks an accelerating target without lag") {
+  auto kf = test::make("filter.kalman", "{ motion: constant_acceleration, q_jerk: 0.001 m2/s5 }");
+  test::Collector out;
+  out.attach_to(*kf);
+  Diagnostics d;
+  kf->start_run({0, 1, &d});
+  for (int k = 0; k < 400; ++k) {
+    const double t = 0.1 * k;
+    kf->on_measurement(cartesian(t, Vec3(0.5 * 20 * t * t, 0, 0), 0.5), 0);
+  }
+  const auto& e = out.estimates.back();
+  CHECK(e.state.size() == 9);
+  CHECK(e.state(2) == Approx(20).epsilon(0.02));  // ax
+  CHECK(e.enu(3) == Approx(20 * 39.9).epsilon(0.001));
+}
+
+TEST_CASE("wrong inputs and parameters are clear errors") {
+  auto kf = test::make("filter.kalman");
+  Diagnostics d;
+  kf->start_run({0, 1, &d});
+  Measurement m = cartesian(0, Vec3(1, 2, 3), 1);
+  m.frame = Frame::Spherical;
+  CHECK_THROWS_WITH(kf->on_measurement(m, 0), Catch::Contains("convert"));
+  CHECK_THROWS_WITH(test::make("filter.kalman", "{ motion: constant_acceleration, q: 1 }"), Catch::Contains("q_jerk"));
+  CHECK_THROWS_WITH(test::make("filter.kalman", "{ init: explicit }"), Catch::Contains("initial_position"));
+  CHECK_THROWS_WITH(test::make("filter.kalman", "{ q: 1 m2/s3, sigma_accel: 1 m/s2 }"), Catch::Contains("not both"));
+}

@@ -1,0 +1,168 @@
+// Purpose: validation of trajectory segment records and exact propagation of CV, CA and coordinated-turn pieces.
+#include "flight_plan.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <string>
+
+namespace trackflow::sim {
+namespace {
+
+// sin(x)/x without the 0/0 at x = 0; the series error at the switch is ~x^4/120 < 1e-18.
+double sinc(double x) { return std::abs(x) < 1e-4 ? 1.0 - x * x / 6.0 : std::sin(x) / x; }
+
+// Below this speed the direction of a velocity (its heading or climb) is taken as undefined.
+constexpr double kStillSpeed = 1e-9;  // m/s
+
+struct SegmentRule {
+  const char* type;
+  std::vector<std::string> allowed;   // besides `type`
+  std::vector<std::string> required;
+};
+
+const std::vector<SegmentRule>& segment_rules() {
+  static const std::vector<SegmentRule> rules = {
+      {"constant_velocity", {"duration"}, {"duration"}},
+      {"constant_acceleration", {"duration", "acceleration"}, {"duration", "acceleration"}},
+      {"turn", {"duration", "turn_rate"}, {"duration", "turn_rate"}},
+      {"velocity_change", {"velocity", "speed", "heading", "climb"}, {}},
+  };
+  return rules;
+}
+
+std::string quoted_list(const std::vector<std::string>& names) {
+  std::string s;
+  for (const auto& n : names) s += (s.empty() ? "'" : ", '") + n + "'";
+  return s.empty() ? "none" : s;
+}
+
+void check_fields(const Params& rec, const std::string& label) {
+  const std::string& type = rec.text("type");
+  const auto& rules = segment_rules();
+  const auto rule = std::find_if(rules.begin(), rules.end(), [&](const SegmentRule& r) { return type == r.type; });
+  if (rule == rules.end()) throw rec.error("type", label + ": unknown segment type '" + type + "'");
+  for (const auto& [field, value] : rec.values()) {
+    if (field == "type" || value.from_default) continue;
+    if (std::find(rule->allowed.begin(), rule->allowed.end(), field) == rule->allowed.end())
+      throw rec.error(field, label + ": '" + field + "' does not belong to a " + type + " segment (its fields: " +
+                                 quoted_list(rule->allowed) + ")");
+  }
+  for (const auto& field : rule->required)
+    if (!rec.given(field)) throw rec.error(field, label + ": a " + type + " segment needs '" + field + "'");
+  if (type == "velocity_change") {
+    const bool by_vector = rec.given("velocity");
+    const bool by_parts = rec.given("speed") || rec.given("heading") || rec.given("climb");
+    if (by_vector && by_parts) {
+      const char* extra = rec.given("speed") ? "speed" : rec.given("heading") ? "heading" : "climb";
+      throw rec.error(extra, label + ": give either 'velocity' or any of 'speed', 'heading', 'climb', not both");
+    }
+    if (!by_vector && !by_parts)
+      throw rec.error("velocity", label + ": a velocity_change needs 'velocity' or any of 'speed', 'heading', 'climb'");
+  }
+}
+
+// New velocity of a velocity_change record applied to the current velocity v. Whatever is not
+// given is kept from v; keeping a direction of a zero (or, for heading, vertical) velocity is an error.
+Vec3 changed_velocity(const Params& rec, const Vec3& v, const std::string& label) {
+  if (rec.given("velocity")) return rec.vec3("velocity");
+  const double horizontal = std::hypot(v.x(), v.y());
+  const double speed = rec.given("speed") ? rec.real("speed") : v.norm();
+  if (speed <= 0.0) return Vec3::Zero();
+  double climb = 0.0;
+  if (rec.given("climb"))
+    climb = rec.real("climb");
+  else if (v.norm() > kStillSpeed)
+    climb = std::atan2(v.z(), horizontal);
+  else
+    throw rec.error("climb", label + ": the velocity before this change is zero, so there is no climb angle to "
+                                     "keep; give 'climb'");
+  const double cos_climb = std::cos(climb);
+  double heading = 0.0;
+  if (rec.given("heading"))
+    heading = rec.real("heading");
+  else if (horizontal > kStillSpeed)
+    heading = std::atan2(v.x(), v.y());  // compass: from north, clockwise
+  else if (std::abs(cos_climb) > 1e-12)  // a vertical new velocity needs no heading
+    throw rec.error("heading", label + ": the velocity before this change is vertical or zero, so there is no "
+                                       "heading to keep; give 'heading'");
+  return speed * Vec3(cos_climb * std::sin(heading), cos_climb * std::cos(heading), std::sin(climb));
+}
+
+}  // namespace
+
+Kinematics evaluate(const MotionPiece& p, double t) {
+  const double dt = t - p.start;
+  switch (p.motion) {
+    case Motion::ConstantVelocity:
+      return {p.position + dt * p.velocity, p.velocity, Vec3::Zero()};
+    case Motion::ConstantAcceleration:
+      return {p.position + dt * p.velocity + 0.5 * dt * dt * p.acceleration, p.velocity + dt * p.acceleration,
+              p.acceleration};
+    case Motion::Turn: {
+      // Horizontal velocity rotates by theta = w dt; position gains the integral of that rotation:
+      // [[sin(theta)/w, -(1-cos theta)/w], [(1-cos theta)/w, sin(theta)/w]] v_h, written with sinc so
+      // that w -> 0 tends to straight flight instead of 0/0.
+      const double w = p.turn_rate, theta = w * dt;
+      const double c = std::cos(theta), s = std::sin(theta);
+      const double a = dt * sinc(theta);                             // sin(theta)/w
+      const double b = dt * std::sin(0.5 * theta) * sinc(0.5 * theta);  // (1 - cos theta)/w
+      const double vx = p.velocity.x(), vy = p.velocity.y(), vz = p.velocity.z();
+      Kinematics k;
+      k.position = p.position + Vec3(a * vx - b * vy, b * vx + a * vy, dt * vz);
+      k.velocity = Vec3(c * vx - s * vy, s * vx + c * vy, vz);
+      k.acceleration = Vec3(-w * k.velocity.y(), w * k.velocity.x(), 0.0);  // w z^ x v: centripetal
+      return k;
+    }
+  }
+  return {p.position, p.velocity, Vec3::Zero()};
+}
+
+std::vector<MotionPiece> build_flight_plan(const Params& params) {
+  const auto& segments = params.records("segments");
+  if (segments.empty()) throw params.error("segments", "needs at least one segment");
+  std::vector<MotionPiece> pieces;
+  pieces.reserve(segments.size() + 1);
+  double t = params.real("start_time");
+  Vec3 p = params.vec3("initial_position");
+  Vec3 v = params.vec3("initial_velocity");
+  bool change_pending = false;
+  for (size_t i = 0; i < segments.size(); ++i) {
+    const Params& rec = segments[i];
+    const std::string label = "segment " + std::to_string(i + 1) + " (" + rec.text("type") + ")";
+    check_fields(rec, label);
+    const std::string& type = rec.text("type");
+    if (type == "velocity_change") {
+      v = changed_velocity(rec, v, label);
+      change_pending = true;
+      continue;
+    }
+    MotionPiece piece;
+    piece.start = t;
+    piece.end = t + rec.real("duration");
+    piece.position = p;
+    piece.velocity = v;
+    if (type == "constant_acceleration") {
+      piece.motion = Motion::ConstantAcceleration;
+      piece.acceleration = rec.vec3("acceleration");
+    } else if (type == "turn") {
+      piece.motion = Motion::Turn;
+      piece.turn_rate = rec.real("turn_rate");
+    }
+    const Kinematics end = evaluate(piece, piece.end);
+    p = end.position;
+    v = end.velocity;
+    t = piece.end;
+    pieces.push_back(piece);
+    change_pending = false;
+  }
+  if (change_pending || pieces.empty()) {
+    MotionPiece last;
+    last.start = last.end = t;
+    last.position = p;
+    last.velocity = v;
+    pieces.push_back(last);
+  }
+  return pieces;
+}
+
+}  // namespace trackflow::sim

@@ -1,0 +1,267 @@
+// Purpose: tests of sim.trajectory: closed-form CV/CA, exact turns, velocity changes, sample times, record validation.
+#include <catch2/catch.hpp>
+
+#include "plugin_fixture.hpp"
+
+#include <cmath>
+#include <cstdio>
+#include <numbers>
+#include <string>
+
+using namespace trackflow;
+
+namespace {
+
+std::vector<Truth> fly(const std::string& yaml) {
+  auto gen = test::make("sim.trajectory", yaml);
+  test::Collector out;
+  out.attach_to(*gen);
+  test::drain(*gen);
+  return out.truths;
+}
+
+std::string num(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof buf, "%.17g", v);
+  return buf;
+}
+
+// The message of the ConfigError that building `yaml` throws ("" if none).
+std::string config_error(const std::string& yaml) {
+  try {
+    (void)test::make("sim.trajectory", yaml);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return {};
+}
+
+// Reference turn: RK4 on dp/dt = v, dv/dt = w z^ x v with a small step, independent of the plugin's closed form.
+void integrate_turn(Vec3& p, Vec3& v, double w, double duration, int steps) {
+  const double h = duration / steps;
+  auto accel = [w](const Vec3& vel) { return Vec3(-w * vel.y(), w * vel.x(), 0.0); };
+  for (int i = 0; i < steps; ++i) {
+    const Vec3 k1p = v, k1v = accel(v);
+    const Vec3 k2p = v + 0.5 * h * k1v, k2v = accel(v + 0.5 * h * k1v);
+    const Vec3 k3p = v + 0.5 * h * k2v, k3v = accel(v + 0.5 * h * k2v);
+    const Vec3 k4p = v + h * k3v, k4v = accel(v + h * k3v);
+    p += h / 6 * (k1p + 2 * k2p + 2 * k3p + k4p);
+    v += h / 6 * (k1v + 2 * k2v + 2 * k3v + k4v);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("constant velocity then constant acceleration follow the closed form") {
+  const auto truths = fly(R"(
+    rate: 10 Hz
+    initial_position: [100 m, -200 m, 50 m]
+    initial_velocity: [10 m/s, 20 m/s, -1 m/s]
+    target: 7
+    segments:
+      - {type: constant_velocity, duration: 5 s}
+      - {type: constant_acceleration, duration: 4 s, acceleration: [1, -2, 0.5]}
+  )");
+  REQUIRE(truths.size() == 91);
+  const Vec3 p0(100, -200, 50), v0(10, 20, -1), a(1, -2, 0.5);
+  const Vec3 p5 = p0 + 5 * v0;
+  for (const Truth& t : truths) {
+    CHECK(t.target == 7u);
+    Vec3 p, v, acc;
+    if (t.time < 5.0) {
+      p = p0 + t.time * v0, v = v0, acc = Vec3::Zero();
+    } else {
+      const double s = t.time - 5.0;
+      p = p5 + s * v0 + 0.5 * s * s * a, v = v0 + s * a, acc = a;
+    }
+    CHECK((t.position - p).norm() < 1e-9);
+    CHECK((t.velocity - v).norm() < 1e-12);
+    CHECK((t.acceleration - acc).norm() == 0.0);
+  }
+  CHECK(truths.back().time == 9.0);
+}
+
+TEST_CASE("a full circle returns to its start with constant speed and radius v / turn_rate") {
+  // Paper 002 scenario 1: radius 1500 m at 200 m/s and 150 m altitude, so turn_rate = v / R.
+  const double v = 200.0, R = 1500.0, w = v / R, period = 2 * std::numbers::pi / w;
+  const int samples_per_circle = 1884;  // about 40 Hz; the rate is chosen so the last sample lands on the end
+  const auto truths = fly("rate: " + num(samples_per_circle / period) + " Hz\n" +
+                          "initial_position: [0, 0, 150 m]\ninitial_velocity: [200 m/s, 0, 0]\n"
+                          "segments:\n  - {type: turn, turn_rate: " + num(w) + " rad/s, duration: " + num(period) + " s}\n");
+  REQUIRE(truths.size() == samples_per_circle + 1);
+  CHECK(truths.back().time == Approx(period).epsilon(1e-14));
+  CHECK((truths.back().position - truths.front().position).norm() < 1e-6);
+  // Counter-clockwise from an eastward start: the centre is to the left (north) of the start.
+  const Vec3 centre(0.0, R, 150.0);
+  double farthest = 0.0;
+  for (const Truth& t : truths) {
+    CHECK(t.velocity.norm() == Approx(v).epsilon(1e-12));
+    CHECK((t.position - centre).norm() == Approx(R).epsilon(1e-10));
+    CHECK(t.position.z() == 150.0);
+    CHECK(t.acceleration.norm() == Approx(v * v / R).epsilon(1e-12));
+    CHECK(t.acceleration.dot(centre - t.position) > 0.0);  // centripetal
+    farthest = std::max(farthest, (t.position - truths.front().position).norm());
+  }
+  CHECK(farthest == Approx(2 * R).epsilon(1e-6));  // diameter
+  // A quarter of the way round, a counter-clockwise turn heads north.
+  const Truth& quarter = truths[samples_per_circle / 4];
+  CHECK(quarter.velocity.y() > 0.99 * v);
+}
+
+TEST_CASE("a climbing turn keeps its vertical velocity and matches a fine numerical integration") {
+  const auto truths = fly(R"(
+    rate: 4 Hz
+    initial_position: [1 km, 2 km, 300 m]
+    initial_velocity: [-50 m/s, 120 m/s, 3 m/s]
+    segments:
+      - {type: turn, turn_rate: -6 deg/s, duration: 7.25 s}
+  )");
+  REQUIRE(truths.size() == 30);
+  Vec3 p(1000, 2000, 300), vel(-50, 120, 3);
+  integrate_turn(p, vel, -6 * std::numbers::pi / 180, 7.25, 20000);
+  CHECK((truths.back().position - p).norm() < 1e-6);
+  CHECK((truths.back().velocity - vel).norm() < 1e-8);
+  for (const Truth& t : truths) CHECK(t.velocity.z() == 3.0);
+}
+
+TEST_CASE("paper 002 scenario 2: a velocity change to 300 m/s with a 60 degree climb") {
+  const auto truths = fly(R"(
+    rate: 40 Hz
+    initial_position: [0, 0, 100 m]
+    initial_velocity: [150 m/s, 0, 0]
+    segments:
+      - {type: constant_velocity, duration: 3 s}
+      - {type: velocity_change, speed: 300 m/s, climb: 60 deg}
+      - {type: constant_velocity, duration: 2 s}
+  )");
+  REQUIRE(truths.size() == 201);
+  const double c60 = std::cos(std::numbers::pi / 3), s60 = std::sin(std::numbers::pi / 3);
+  const Vec3 after(300 * c60, 0, 300 * s60);  // heading kept (east)
+  const Truth& before = truths[119];
+  const Truth& at = truths[120];
+  CHECK(before.time < 3.0);
+  REQUIRE(at.time == 3.0);
+  CHECK((before.velocity - Vec3(150, 0, 0)).norm() < 1e-12);
+  CHECK((at.velocity - after).norm() < 1e-9);  // the sample at the change already shows it
+  CHECK(at.velocity.norm() == Approx(300));
+  CHECK(std::atan2(at.velocity.z(), std::hypot(at.velocity.x(), at.velocity.y())) == Approx(std::numbers::pi / 3));
+  CHECK((at.position - Vec3(450, 0, 100)).norm() < 1e-9);
+  CHECK((truths.back().position - (Vec3(450, 0, 100) + 2 * after)).norm() < 1e-9);
+}
+
+TEST_CASE("velocity_change: heading alone keeps speed and climb - a full vector replaces the velocity") {
+  const auto truths = fly(R"(
+    rate: 1 Hz
+    initial_position: [0, 0, 0]
+    initial_velocity: [30 m/s, 0, 40 m/s]
+    segments:
+      - {type: velocity_change, heading: 180 deg}
+      - {type: constant_velocity, duration: 1 s}
+      - {type: velocity_change, velocity: [1, 2, 3]}
+  )");
+  REQUIRE(truths.size() == 2);
+  CHECK((truths[0].velocity - Vec3(0, -30, 40)).norm() < 1e-12);  // due south, same speed and climb
+  CHECK((truths[1].position - Vec3(0, -30, 40)).norm() < 1e-12);
+  CHECK((truths[1].velocity - Vec3(1, 2, 3)).norm() == 0.0);     // trailing change shows at the end
+}
+
+TEST_CASE("a straight constant-speed descent (landing approach)") {
+  const auto truths = fly(R"(
+    rate: 20 Hz
+    initial_position: [-5 km, 0, 262 m]
+    initial_velocity: [0, 0, 0]
+    segments:
+      - {type: velocity_change, speed: 60 m/s, heading: 90 deg, climb: -3 deg}
+      - {type: constant_velocity, duration: 80 s}
+  )");
+  REQUIRE(truths.size() == 1601);
+  const double g = -3 * std::numbers::pi / 180;
+  const Vec3 v(60 * std::cos(g), 0, 60 * std::sin(g));
+  CHECK((truths.back().position - (Vec3(-5000, 0, 262) + 80 * v)).norm() < 1e-9);
+  for (const Truth& t : truths) CHECK(t.velocity.norm() == Approx(60));
+}
+
+TEST_CASE("sample times are start_time + k / rate up to the end, inclusive") {
+  SECTION("10 Hz from 2 s over 3 s") {
+    const auto truths = fly("rate: 10 Hz\nstart_time: 2 s\ninitial_position: [0, 0, 0]\n"
+                            "segments: [{type: constant_velocity, duration: 3 s}]");
+    REQUIRE(truths.size() == 31);
+    for (size_t k = 0; k < truths.size(); ++k) CHECK(truths[k].time == 2.0 + static_cast<double>(k) / 10.0);
+    CHECK(truths.back().time == 5.0);
+  }
+  SECTION("3 Hz over 1 s: the period is not a binary fraction") {
+    const auto truths = fly("rate: 3 Hz\ninitial_position: [0, 0, 0]\nsegments: [{type: constant_velocity, duration: 1 s}]");
+    REQUIRE(truths.size() == 4);
+    CHECK(truths[1].time == 1.0 / 3.0);
+    CHECK(truths[3].time == 1.0);
+  }
+  SECTION("boundaries summed with rounding (0.1 + 0.2 s) still put the change on the sample at 0.3 s") {
+    const auto truths = fly(R"(
+      rate: 40 Hz
+      initial_position: [0, 0, 0]
+      initial_velocity: [1, 0, 0]
+      segments:
+        - {type: constant_velocity, duration: 0.1 s}
+        - {type: constant_velocity, duration: 0.2 s}
+        - {type: velocity_change, velocity: [0, 5, 0]}
+        - {type: constant_velocity, duration: 0.1 s}
+    )");
+    REQUIRE(truths.size() == 17);
+    CHECK(truths[12].time == 0.3);
+    CHECK(truths[11].velocity.x() == 1.0);
+    CHECK(truths[12].velocity.y() == 5.0);
+    CHECK(truths.back().time == 0.4);
+  }
+  SECTION("each run starts over") {
+    auto gen = test::make("sim.trajectory", "initial_position: [0, 0, 0]\nsegments: [{type: constant_velocity, duration: 1 s}]");
+    test::Collector out;
+    out.attach_to(*gen);
+    test::drain(*gen, 1, 0);
+    test::drain(*gen, 2, 1);
+    REQUIRE(out.truths.size() == 22);
+    CHECK(out.truths[11].time == 0.0);
+  }
+}
+
+TEST_CASE("inconsistent segment records are refused with the field named") {
+  const std::string head = "initial_position: [0, 0, 0]\ninitial_velocity: [10, 0, 0]\nsegments:\n";
+  struct Case {
+    const char* segment;
+    const char* field;
+  };
+  const Case cases[] = {
+      {"{type: constant_velocity}", "duration"},
+      {"{type: constant_velocity, duration: 1 s, turn_rate: 1 deg/s}", "turn_rate"},
+      {"{type: constant_acceleration, duration: 1 s}", "acceleration"},
+      {"{type: turn, duration: 1 s}", "turn_rate"},
+      {"{type: turn, duration: 1 s, turn_rate: 1 deg/s, speed: 3}", "speed"},
+      {"{type: velocity_change, duration: 1 s, speed: 3}", "duration"},
+      {"{type: velocity_change}", "velocity"},
+      {"{type: velocity_change, velocity: [1, 2, 3], climb: 3 deg}", "climb"},
+      {"{type: constant_velocity, duration: 0 s}", "duration"},
+      {"{type: velocity_change, climb: 100 deg}", "climb"},
+      {"{type: hover, duration: 1 s}", "type"},
+  };
+  for (const auto& c : cases) {
+    INFO(c.segment);
+    const std::string msg = config_error(head + "  - " + c.segment + "\n");
+    CHECK_THAT(msg, Catch::Matchers::Contains(std::string("'") + c.field + "'"));
+  }
+  CHECK_THAT(config_error(head), Catch::Matchers::Contains("segments"));
+  CHECK_THAT(config_error("initial_position: [0, 0, 0]\nsegments: []"), Catch::Matchers::Contains("segments"));
+  CHECK_THAT(config_error("segments: [{type: constant_velocity, duration: 1 s}]"),
+             Catch::Matchers::Contains("initial_position"));
+  // The segment's number is in the message, so the analyst knows which entry.
+  CHECK_THAT(config_error(head + "  - {type: constant_velocity, duration: 1 s}\n  - {type: turn, duration: 2 s}\n"),
+             Catch::Matchers::Contains("segment 2"));
+}
+
+TEST_CASE("keeping the direction of a zero or vertical velocity is refused - a vertical target is fine") {
+  const std::string still = "initial_position: [0, 0, 0]\nsegments:\n";
+  CHECK_THAT(config_error(still + "  - {type: velocity_change, speed: 100}\n"), Catch::Matchers::Contains("'climb'"));
+  CHECK_THAT(config_error(still + "  - {type: velocity_change, speed: 100, climb: 10 deg}\n"),
+             Catch::Matchers::Contains("'heading'"));
+  const auto up = fly(still + "  - {type: velocity_change, speed: 100, climb: 90 deg}\n");
+  REQUIRE(up.size() == 1);
+  CHECK((up[0].velocity - Vec3(0, 0, 100)).norm() < 1e-9);
+}

@@ -1,0 +1,97 @@
+#!/usr/bin/env bash
+# Purpose: every kind of configuration error exits 2 with file:line:col and the node id.
+set -u
+TF=$1
+source "$(dirname "$0")/lib.sh"
+
+# A valid base pipeline; each case below breaks one thing.
+base() {
+  cat <<'YAML'
+pipeline: { name: errors, seed: 1, runs: 1 }
+nodes:
+  - id: truth
+    type: sim.trajectory
+    params:
+      rate: 10 Hz
+      initial_position: [6000, 8000, 1000]
+      initial_velocity: [-150, 50, 0]
+      segments: [ { type: constant_velocity, duration: 5 s } ]
+  - id: radar
+    type: sim.radar
+    input: truth
+    params: { sigma_range: 10 m }
+  - id: cm
+    type: convert.classical
+    input: radar
+  - id: kf
+    type: filter.kalman
+    input: cm
+  - id: score
+    type: sink.metrics
+    inputs: [kf, truth]
+YAML
+}
+
+base > "$TMP/ok.yaml"
+expect_run "valid pipeline validates" 0 "ok" -- "$TF" validate "$TMP/ok.yaml"
+
+base | sed 's/type: filter.kalman/type: filter.kalmn/' > "$TMP/unknown_type.yaml"
+expect_run "unknown type" 2 "unknown_type.yaml:17:11: node 'kf': unknown type 'filter.kalmn' \(did you mean 'filter.kalman'\?\). Available: .*sink.metrics" \
+  -- "$TF" validate "$TMP/unknown_type.yaml"
+
+base | sed 's/sigma_range: 10 m/sigma_rnge: 10 m/' > "$TMP/unknown_param.yaml"
+expect_run "unknown parameter, with suggestion" 2 "unknown_param.yaml:13:14: node 'radar': unknown parameter 'sigma_rnge' \(did you mean 'sigma_range'\?\)" \
+  -- "$TF" validate "$TMP/unknown_param.yaml"
+
+base | sed '/initial_position/d' > "$TMP/missing.yaml"
+expect_run "missing required parameter" 2 "missing.yaml:[0-9]+:[0-9]+: node 'truth': missing required parameter 'initial_position'" \
+  -- "$TF" validate "$TMP/missing.yaml"
+
+base | sed 's/rate: 10 Hz/rate: fast/' > "$TMP/wrong_type.yaml"
+expect_run "wrong type" 2 "wrong_type.yaml:6:13: node 'truth': parameter 'rate': 'fast' is not a number" \
+  -- "$TF" validate "$TMP/wrong_type.yaml"
+
+base | sed 's/sigma_range: 10 m/sigma_range: 3 mrad/' > "$TMP/wrong_unit.yaml"
+expect_run "wrong unit dimension" 2 "wrong_unit.yaml:13:27: node 'radar': parameter 'sigma_range' has unit dimension m, but '3 mrad' is rad" \
+  -- "$TF" validate "$TMP/wrong_unit.yaml"
+
+base | sed 's/- id: cm/- id: radar/' > "$TMP/duplicate.yaml"
+expect_run "duplicate id" 2 "duplicate.yaml:14:5: node 'radar': duplicate node id 'radar' \(first defined at .*duplicate.yaml:10:5\)" \
+  -- "$TF" validate "$TMP/duplicate.yaml"
+
+base | sed 's/input: cm/input: cmm/' > "$TMP/dangling.yaml"
+expect_run "dangling input" 2 "dangling.yaml:18:12: node 'kf': input 'cmm' is not a node \(did you mean 'cm'\?\)" \
+  -- "$TF" validate "$TMP/dangling.yaml"
+
+base | sed 's/input: radar/input: kf/' > "$TMP/cycle.yaml"
+expect_run "cycle" 2 "cycle.yaml:[0-9]+:5: node '(cm|kf)': the graph has a cycle through: cm -> kf" \
+  -- "$TF" validate "$TMP/cycle.yaml"
+
+base | sed 's/input: radar/input: truth/' > "$TMP/wrong_kind.yaml"
+expect_run "input of the wrong kind (truth into a converter)" 2 "wrong_kind.yaml:16:12: node 'cm': input 'truth' \(sim.trajectory\) produces truth, but convert.classical accepts measurement" \
+  -- "$TF" validate "$TMP/wrong_kind.yaml"
+
+{ base; printf '  - id: cm2\n    type: convert.classical\n    input: kf\n'; } > "$TMP/estimate_into_converter.yaml"
+expect_run "an estimate into a converter" 2 "estimate_into_converter.yaml:24:12: node 'cm2': input 'kf' \(filter.kalman\) produces estimate, but convert.classical accepts measurement" \
+  -- "$TF" validate "$TMP/estimate_into_converter.yaml"
+
+printf 'pipeline: { name: x }\nnodes:\n  - id: a\n    type: [oops\n' > "$TMP/syntax.yaml"
+expect_run "YAML syntax error" 2 "syntax.yaml:[0-9]+:[0-9]+: YAML syntax error" -- "$TF" validate "$TMP/syntax.yaml"
+
+expect_run "--set of an unknown parameter" 2 "node 'kf': unknown parameter 'qq' \(did you mean 'q'\?\)" \
+  -- "$TF" validate "$TMP/ok.yaml" --set kf.qq=3
+expect_run "--set with a wrong unit" 2 "node 'radar': parameter 'sigma_range' has unit dimension m" \
+  -- "$TF" validate "$TMP/ok.yaml" --set "radar.sigma_range=3 mrad"
+expect_run "missing file" 2 "cannot open pipeline file" -- "$TF" validate "$TMP/nope.yaml"
+expect_run "unknown command" 2 "unknown command 'rnu' \(did you mean 'run'\?\)" -- "$TF" rnu
+expect_run "describe an unknown type" 2 "did you mean 'sim.radar'" -- "$TF" describe sim.rdar
+expect_run "run --help documents exit codes and options" 0 "--threads" -- "$TF" run --help
+expect_run "top-level help lists commands and exit codes" 0 "Exit codes: 0 ok, 1 an .expect. check failed, 2 bad" -- "$TF" --help
+
+printf 'expect:\n  score.position_rmse: { max: 0.001 }\n' > "$TMP/fail_tail.yaml"
+{ base; cat "$TMP/fail_tail.yaml"; } > "$TMP/expect_fail.yaml"
+expect_run "a failed expect exits 1" 1 "FAIL  score.position_rmse" -- "$TF" run "$TMP/expect_fail.yaml" --out "$TMP/out"
+{ base; printf 'expect:\n  score.position_rmsee: { max: 1 }\n'; } > "$TMP/expect_typo.yaml"
+expect_run "an expect naming a missing metric is a config error" 2 "has no metric 'position_rmsee' \(did you mean 'position_rmse'\?\)" \
+  -- "$TF" run "$TMP/expect_typo.yaml" --out "$TMP/out"
+finish
