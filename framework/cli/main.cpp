@@ -298,8 +298,7 @@ int cmd_describe(int argc, char** argv) {
   if (type.empty()) throw po::error("describe needs a TYPE (see `trackflow plugins`) or --all");
   const auto* t = reg.find(type);
   if (!t)
-    throw ConfigError("unknown type '" + type + "'" + did_you_mean(type, reg.type_names()) +
-                      ". Available: " + join(reg.type_names()));
+    throw ConfigError(unknown_type_message(type, reg));
   describe(std::cout, *t, md);
   return kOk;
 }

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <exception>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <thread>
 
@@ -61,14 +62,52 @@ Outcome run_graph(const Graph& g, const PluginRegistry& registry, const RunOptio
   const size_t N = g.nodes.size();
   const std::uint64_t runs = std::max<std::uint64_t>(1, opt.runs);
   const unsigned threads = static_cast<unsigned>(std::clamp<std::uint64_t>(opt.threads, 1, runs));
-  std::vector<RunRecord> records(runs);
   std::atomic<std::uint64_t> next_run{0}, done{0};
   std::atomic<bool> failed{false};
   std::exception_ptr error;
   std::mutex error_mutex;
 
+  Outcome out;
+  out.runs = runs;
+  out.nodes.resize(N);
+  for (size_t i = 0; i < N; ++i) {
+    out.nodes[i].id = g.nodes[i].config.id;
+    out.nodes[i].type = g.nodes[i].config.type;
+  }
+
   // The aggregating instance is built first so construction errors surface before any thread starts.
   GraphInstance aggregate = instantiate(g, registry);
+
+  // Finished runs wait here until every earlier run has been merged: merging happens strictly
+  // in run order (so sums are identical for any thread count) and memory stays bounded by the
+  // runs in flight, not the ensemble size.
+  std::map<std::uint64_t, RunRecord> pending;
+  std::uint64_t next_merge = 0;
+  std::mutex merge_mutex;
+  auto merge_one = [&](std::uint64_t r, RunRecord& rec) {
+    out.source_items += rec.source_items;
+    for (size_t i = 0; i < N; ++i)
+      if (rec.results[i]) aggregate.components[i]->merge(*rec.results[i]);
+    for (const auto& s : rec.diagnostics.skips) {
+      for (auto& n : out.nodes) {
+        if (n.id != s.node) continue;
+        ++n.skips;
+        if (n.skip_examples.size() < 5)
+          n.skip_examples.push_back((runs > 1 ? "run " + std::to_string(r) + ": " : "") + s.message);
+      }
+    }
+    for (const auto& w : rec.diagnostics.warnings)
+      if (out.warnings.size() < 20) out.warnings.push_back(w.node + ": " + w.message);
+  };
+  auto complete = [&](std::uint64_t run, RunRecord&& rec) {
+    std::lock_guard<std::mutex> lock(merge_mutex);
+    pending.emplace(run, std::move(rec));
+    for (auto it = pending.find(next_merge); it != pending.end(); it = pending.find(next_merge)) {
+      merge_one(it->first, it->second);
+      pending.erase(it);
+      ++next_merge;
+    }
+  };
 
   auto worker = [&]() {
     try {
@@ -76,7 +115,7 @@ Outcome run_graph(const Graph& g, const PluginRegistry& registry, const RunOptio
       for (;;) {
         const std::uint64_t run = next_run.fetch_add(1);
         if (run >= runs || failed.load()) break;
-        RunRecord& rec = records[run];
+        RunRecord rec;
         try {
           for (size_t i = 0; i < N; ++i)
             inst.components[i]->start_run({run, derive_seed(opt.seed, run, g.nodes[i].config.id), &rec.diagnostics});
@@ -88,6 +127,7 @@ Outcome run_graph(const Graph& g, const PluginRegistry& registry, const RunOptio
         } catch (const std::exception& e) {
           throw DataError("run " + std::to_string(run) + ": " + e.what());
         }
+        complete(run, std::move(rec));
         done.fetch_add(1);
       }
     } catch (...) {
@@ -110,31 +150,8 @@ Outcome run_graph(const Graph& g, const PluginRegistry& registry, const RunOptio
   for (auto& t : pool) t.join();
   const auto t1 = std::chrono::steady_clock::now();
   if (error) std::rethrow_exception(error);
-
-  Outcome out;
-  out.runs = runs;
   out.seconds = std::chrono::duration<double>(t1 - t0).count();
-  out.nodes.resize(N);
-  for (size_t i = 0; i < N; ++i) {
-    out.nodes[i].id = g.nodes[i].config.id;
-    out.nodes[i].type = g.nodes[i].config.type;
-  }
-  for (std::uint64_t r = 0; r < runs; ++r) {
-    RunRecord& rec = records[r];
-    out.source_items += rec.source_items;
-    for (size_t i = 0; i < N; ++i)
-      if (rec.results[i]) aggregate.components[i]->merge(*rec.results[i]);
-    for (const auto& s : rec.diagnostics.skips) {
-      for (auto& n : out.nodes) {
-        if (n.id != s.node) continue;
-        ++n.skips;
-        if (n.skip_examples.size() < 5) n.skip_examples.push_back((runs > 1 ? "run " + std::to_string(r) + ": " : "") + s.message);
-      }
-    }
-    for (const auto& w : rec.diagnostics.warnings)
-      if (out.warnings.size() < 20) out.warnings.push_back(w.node + ": " + w.message);
-    rec.results.clear();
-  }
+
   for (size_t i = 0; i < N; ++i) {
     FinishContext ctx{g.nodes[i].config.id, opt.output_dir, runs};
     aggregate.components[i]->finish(out.nodes[i].summary, ctx);

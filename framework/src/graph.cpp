@@ -16,6 +16,8 @@ std::string kinds(ItemMask m) {
   return k.empty() ? "nothing" : join(k, "/");
 }
 
+}  // namespace
+
 std::string unknown_type_message(const std::string& type, const PluginRegistry& reg) {
   const auto names = reg.type_names();
   std::string m = "unknown type '" + type + "'" + did_you_mean(type, names) + ". Available: " +
@@ -23,8 +25,6 @@ std::string unknown_type_message(const std::string& type, const PluginRegistry& 
   for (const auto& p : reg.problems()) m += "\n  plugin not loaded: " + p.str();
   return m;
 }
-
-}  // namespace
 
 Graph build_graph(PipelineConfig cfg, const PluginRegistry& registry) {
   Graph g;
@@ -128,16 +128,27 @@ Graph build_graph(PipelineConfig cfg, const PluginRegistry& registry) {
     }
   }
   if (static_cast<int>(g.order.size()) != N) {
+    // Nodes left over either lie on a cycle or sit downstream of one. Walking from any of them
+    // to a left-over input must revisit a node; the walk from that node back to itself is a cycle.
+    int at = 0;
+    while (done[at]) ++at;
+    std::vector<int> path;
+    std::vector<int> seen_at(N, -1);
+    while (seen_at[at] < 0) {
+      seen_at[at] = static_cast<int>(path.size());
+      path.push_back(at);
+      for (int in : g.nodes[at].inputs)
+        if (!done[in]) {
+          at = in;
+          break;
+        }
+    }
     std::vector<std::string> cyc;
-    int first = -1;
-    for (int i = 0; i < N; ++i)
-      if (!done[i]) {
-        cyc.push_back(g.nodes[i].config.id);
-        if (first < 0) first = i;
-      }
-    throw ConfigError("the graph has a cycle through: " + join(cyc, " -> ") +
-                          " (each node must come after its inputs)",
-                      g.nodes[first].config.loc, g.nodes[first].config.id);
+    for (size_t k = path.size(); k-- > static_cast<size_t>(seen_at[at]);) cyc.push_back(g.nodes[path[k]].config.id);
+    cyc.push_back(cyc.front());
+    const GraphNode& first = g.nodes[at];
+    throw ConfigError("the graph has a cycle: " + join(cyc, " -> ") + " (each node must come after its inputs)",
+                      first.config.loc, first.config.id);
   }
 
   // Plugin-side checks (segment consistency, data files) run at construction.

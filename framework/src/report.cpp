@@ -4,6 +4,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <sstream>
@@ -146,6 +147,9 @@ void print_summary(std::ostream& os, const Graph& g, const Outcome& out, unsigne
 }
 
 void write_metrics_json(const std::string& path, const Outcome& out) {
+  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
+  std::error_code ec;
+  if (!parent.empty()) std::filesystem::create_directories(parent, ec);
   std::ofstream f(path);
   if (!f) throw ConfigError("cannot write metrics JSON '" + path + "'");
   f << "{";

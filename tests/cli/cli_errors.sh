@@ -36,11 +36,11 @@ base > "$TMP/ok.yaml"
 expect_run "valid pipeline validates" 0 "ok" -- "$TF" validate "$TMP/ok.yaml"
 
 base | sed 's/type: filter.kalman/type: filter.kalmn/' > "$TMP/unknown_type.yaml"
-expect_run "unknown type" 2 "unknown_type.yaml:17:11: node 'kf': unknown type 'filter.kalmn' \(did you mean 'filter.kalman'\?\). Available: .*sink.metrics" \
+expect_run "unknown type" 2 "unknown_type.yaml:18:11: node 'kf': unknown type 'filter.kalmn' \(did you mean 'filter.kalman'\?\). Available: .*sink.metrics" \
   -- "$TF" validate "$TMP/unknown_type.yaml"
 
 base | sed 's/sigma_range: 10 m/sigma_rnge: 10 m/' > "$TMP/unknown_param.yaml"
-expect_run "unknown parameter, with suggestion" 2 "unknown_param.yaml:13:14: node 'radar': unknown parameter 'sigma_rnge' \(did you mean 'sigma_range'\?\)" \
+expect_run "unknown parameter, with suggestion" 2 "unknown_param.yaml:13:15: node 'radar': unknown parameter 'sigma_rnge' \(did you mean 'sigma_range'\?\)" \
   -- "$TF" validate "$TMP/unknown_param.yaml"
 
 base | sed '/initial_position/d' > "$TMP/missing.yaml"
@@ -52,7 +52,7 @@ expect_run "wrong type" 2 "wrong_type.yaml:6:13: node 'truth': parameter 'rate':
   -- "$TF" validate "$TMP/wrong_type.yaml"
 
 base | sed 's/sigma_range: 10 m/sigma_range: 3 mrad/' > "$TMP/wrong_unit.yaml"
-expect_run "wrong unit dimension" 2 "wrong_unit.yaml:13:27: node 'radar': parameter 'sigma_range' has unit dimension m, but '3 mrad' is rad" \
+expect_run "wrong unit dimension" 2 "wrong_unit.yaml:13:28: node 'radar': parameter 'sigma_range' has unit dimension m, but '3 mrad' is rad" \
   -- "$TF" validate "$TMP/wrong_unit.yaml"
 
 base | sed 's/- id: cm/- id: radar/' > "$TMP/duplicate.yaml"
@@ -60,11 +60,12 @@ expect_run "duplicate id" 2 "duplicate.yaml:14:5: node 'radar': duplicate node i
   -- "$TF" validate "$TMP/duplicate.yaml"
 
 base | sed 's/input: cm/input: cmm/' > "$TMP/dangling.yaml"
-expect_run "dangling input" 2 "dangling.yaml:18:12: node 'kf': input 'cmm' is not a node \(did you mean 'cm'\?\)" \
+expect_run "dangling input" 2 "dangling.yaml:19:12: node 'kf': input 'cmm' is not a node \(did you mean 'cm'\?\)" \
   -- "$TF" validate "$TMP/dangling.yaml"
 
-base | sed 's/input: radar/input: kf/' > "$TMP/cycle.yaml"
-expect_run "cycle" 2 "cycle.yaml:[0-9]+:5: node '(cm|kf)': the graph has a cycle through: cm -> kf" \
+# cm takes cm2's output and cm2 takes cm's: kinds match, only the cycle is wrong.
+{ base | sed 's/input: radar/input: cm2/'; printf '  - id: cm2\n    type: convert.classical\n    input: cm\n'; } > "$TMP/cycle.yaml"
+expect_run "cycle" 2 "cycle.yaml:(14|25):5: node 'cm2?': the graph has a cycle: (cm -> cm2 -> cm|cm2 -> cm -> cm2) " \
   -- "$TF" validate "$TMP/cycle.yaml"
 
 base | sed 's/input: radar/input: truth/' > "$TMP/wrong_kind.yaml"
@@ -72,7 +73,7 @@ expect_run "input of the wrong kind (truth into a converter)" 2 "wrong_kind.yaml
   -- "$TF" validate "$TMP/wrong_kind.yaml"
 
 { base; printf '  - id: cm2\n    type: convert.classical\n    input: kf\n'; } > "$TMP/estimate_into_converter.yaml"
-expect_run "an estimate into a converter" 2 "estimate_into_converter.yaml:24:12: node 'cm2': input 'kf' \(filter.kalman\) produces estimate, but convert.classical accepts measurement" \
+expect_run "an estimate into a converter" 2 "estimate_into_converter.yaml:25:12: node 'cm2': input 'kf' \(filter.kalman\) produces estimate, but convert.classical accepts measurement" \
   -- "$TF" validate "$TMP/estimate_into_converter.yaml"
 
 printf 'pipeline: { name: x }\nnodes:\n  - id: a\n    type: [oops\n' > "$TMP/syntax.yaml"

@@ -1,7 +1,10 @@
-// Purpose: kinematic motion models (constant velocity, constant acceleration) with fixed-size F and Q.
+// Purpose: kinematic motion models (constant velocity, constant acceleration, Singer) with fixed-size F and Q.
 #pragma once
 
 #include <Eigen/Core>
+
+#include <array>
+#include <cmath>
 
 namespace trackflow {
 
@@ -91,5 +94,107 @@ struct KinematicModel {
 
 using ConstantVelocity = KinematicModel<2>;
 using ConstantAcceleration = KinematicModel<3>;
+
+// Singer (1970) model: per axis [p, v, a] with the layout and index helpers of
+// ConstantAcceleration, but the acceleration is a first-order Markov process
+//   da/dt = -alpha a + w,  E[w(t) w(s)] = 2 alpha sigma^2 delta(t - s),
+// i.e. stationary acceleration std sigma (sigma_m, m/s2) and correlation time 1/alpha (s).
+// Source: R. A. Singer, "Estimating optimal tracking filter performance for manned maneuvering
+// targets", IEEE Trans. AES-6(4), 1970 (transition and the q11..q33 closed form of Q); restated
+// in X. R. Li & V. P. Jilkov, "Survey of maneuvering target tracking, Part I", IEEE Trans. AES
+// 39(4), 2003, §IV.A. Limits: alpha -> 0 with q = 2 alpha sigma^2 fixed gives the
+// Wiener-process-acceleration CA model (ConstantAcceleration::axis_noise_continuous(T, q));
+// alpha -> inf with q = 2 sigma^2 / alpha fixed makes the acceleration white, and the (p, v)
+// block tends to the CV model with intensity q.
+struct SingerModel {
+  using AxisMatrix = Eigen::Matrix3d;
+  double alpha = 1.0;  // 1/s
+  double sigma = 1.0;  // m/s2
+
+  // Exact e^{A T}, A = [[0,1,0],[0,0,1],[0,0,-alpha]]:
+  // [[1, T, (aT - 1 + e^-aT)/a^2], [0, 1, (1 - e^-aT)/a], [0, 0, e^-aT]].
+  AxisMatrix axis_transition(double T) const { return axis_transition(alpha, T); }
+  // Exact discrete noise 2 alpha sigma^2 * integral_0^T e^{As} b b' e^{A's} ds, b = [0, 0, 1]'.
+  AxisMatrix axis_noise(double T) const { return (2.0 * alpha * sigma * sigma) * noise_per_psd(alpha, T); }
+
+  static AxisMatrix axis_transition(double alpha, double T) {
+    const double x = alpha * T;
+    AxisMatrix F = AxisMatrix::Identity();
+    F(0, 1) = T;
+    F(0, 2) = T * T * phi(2, x);
+    F(1, 2) = T * phi(1, x);
+    F(2, 2) = std::exp(-x);
+    return F;
+  }
+
+  // The integral per unit spectral density of w (Singer's q_ij; multiply by 2 alpha sigma^2).
+  // The closed form cancels catastrophically for small x = alpha T: q11's bracket is O(x^5) built
+  // from O(1) terms, so its relative error is ~1e-16/x^5 (1e-6 at x = 0.01, 10 % at x = 1e-3).
+  // Below kSeriesLimit the Taylor series in x is used instead (entire; kSeriesTerms terms reach
+  // double precision for x < 0.5, where the closed form loses < 1e-13).
+  static AxisMatrix noise_per_psd(double alpha, double T) {
+    const double x = alpha * T;
+    AxisMatrix Q;
+    if (x < kSeriesLimit) {
+      static constexpr auto coeff = series_coefficients();
+      constexpr int m[3] = {2, 1, 0};
+      int ij = 0;
+      for (int i = 0; i < 3; ++i)
+        for (int j = i; j < 3; ++j, ++ij) {
+          double sum = 0.0;  // Horner in -x
+          for (int n = kSeriesTerms - 1; n >= 0; --n) sum = sum * -x + coeff[ij][n];
+          Q(i, j) = Q(j, i) = std::pow(T, m[i] + m[j] + 1) * sum;
+        }
+      return Q;
+    }
+    const double e = std::exp(-x), e2 = e * e, x2 = x * x, x3 = x2 * x;
+    const double a2 = alpha * alpha, a3 = a2 * alpha, a4 = a3 * alpha, a5 = a4 * alpha;
+    Q(0, 0) = (1 - e2 + 2 * x + 2 * x3 / 3 - 2 * x2 - 4 * x * e) / (2 * a5);
+    Q(0, 1) = Q(1, 0) = (e2 + 1 - 2 * e + 2 * x * e - 2 * x + x2) / (2 * a4);
+    Q(0, 2) = Q(2, 0) = (1 - e2 - 2 * x * e) / (2 * a3);
+    Q(1, 1) = (4 * e - 3 - e2 + 2 * x) / (2 * a3);
+    Q(1, 2) = Q(2, 1) = (e2 + 1 - 2 * e) / (2 * a2);
+    Q(2, 2) = (1 - e2) / (2 * alpha);
+    return Q;
+  }
+
+  static constexpr double kSeriesLimit = 0.5;
+  static constexpr int kSeriesTerms = 18;
+
+  // phi_m(x) = sum_k (-x)^k / (k+m)!, m = 0, 1, 2: e^-x, (1 - e^-x)/x, (x - 1 + e^-x)/x^2.
+  static double phi(int m, double x) {
+    if (m == 0) return std::exp(-x);
+    if (x >= kSeriesLimit) {
+      const double em1 = std::expm1(-x);
+      return m == 1 ? -em1 / x : (x + em1) / (x * x);
+    }
+    double sum = 0.0;
+    for (int k = kSeriesTerms - 1; k >= 0; --k) sum = sum * -x + 1.0 / factorial(k + m);
+    return sum;
+  }
+
+ private:
+  static constexpr double factorial(int n) {
+    double f = 1.0;
+    for (int i = 2; i <= n; ++i) f *= i;
+    return f;
+  }
+  // e^{As} b = [s^2 phi_2(alpha s), s phi_1(alpha s), phi_0(alpha s)]' =: s^m_i sum_k (-alpha s)^k/(k+m_i)!
+  // with m = (2, 1, 0); integrating the products over [0, T] gives
+  // Q_ij = T^(m_i+m_j+1) sum_n (-x)^n / (n+m_i+m_j+1) * sum_{k<=n} 1/((k+m_i)! (n-k+m_j)!).
+  static constexpr std::array<std::array<double, kSeriesTerms>, 6> series_coefficients() {
+    std::array<std::array<double, kSeriesTerms>, 6> c{};
+    constexpr int m[3] = {2, 1, 0};
+    int ij = 0;
+    for (int i = 0; i < 3; ++i)
+      for (int j = i; j < 3; ++j, ++ij)
+        for (int n = 0; n < kSeriesTerms; ++n) {
+          double inner = 0.0;
+          for (int k = 0; k <= n; ++k) inner += 1.0 / (factorial(k + m[i]) * factorial(n - k + m[j]));
+          c[ij][n] = inner / (n + m[i] + m[j] + 1);
+        }
+    return c;
+  }
+};
 
 }  // namespace trackflow

@@ -29,6 +29,9 @@ struct Graph {
 // and the node id. Also instantiates each component once so plugin-side checks run now.
 Graph build_graph(PipelineConfig cfg, const PluginRegistry& registry);
 
+// "unknown type 'x' (did you mean 'y'?). Available: ... Searched: ..." plus plugin load problems.
+std::string unknown_type_message(const std::string& type, const PluginRegistry& registry);
+
 // One instantiated copy of the graph (one per worker thread).
 struct GraphInstance {
   std::vector<std::shared_ptr<Component>> components;  // by node index

@@ -1,0 +1,313 @@
+// Purpose: tests of filter.alpha_beta: gains and covariance against the Kalman Riccati recursion, the recursion by hand, Monte Carlo consistency, errors.
+#include "alpha_beta_gains.hpp"
+
+#include <trackflow/host/config.hpp>
+#include <trackflow/host/plugins.hpp>
+#include <trackflow/host/validate.hpp>
+#include <trackflow/rng.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <Eigen/Dense>
+
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+using namespace trackflow;
+
+namespace {
+
+// The plugin is loaded through the same host code `trackflow run` uses, from the file just built.
+const host::PluginRegistry& registry() {
+  static const host::PluginRegistry reg = [] {
+    host::PluginRegistry r;
+    r.load_file(ALPHA_BETA_PLUGIN_FILE);
+    for (const auto& p : r.problems()) FAIL("plugin not loaded: " << p.str());
+    return r;
+  }();
+  return reg;
+}
+
+std::shared_ptr<Component> make(const std::string& yaml_params, const std::string& node = "ab") {
+  const host::RegisteredType* t = registry().find("filter.alpha_beta");
+  REQUIRE(t != nullptr);
+  const host::Value v = host::load_yaml_string(yaml_params, "test params");
+  return registry().create(*t, host::validate_params(t->decl.params, v, node, v.loc));
+}
+
+struct Collector : Component {
+  void on_estimate(const Estimate& e, int) override { estimates.push_back(e); }
+  void attach_to(Component& c) {
+    link = {this, 0, 0xFF};
+    c.out.connect(&link, 1);
+  }
+  std::vector<Estimate> estimates;
+  Link link;
+};
+
+Measurement cartesian(double t, const Vec3& z, const Vec3& variance) {
+  Measurement m;
+  m.time = t;
+  m.frame = Frame::Cartesian;
+  m.value = z;
+  m.covariance = MeasCov::Zero(3, 3);
+  m.covariance.diagonal() = variance;
+  return m;
+}
+
+// Discrete white-noise-acceleration model of one axis: x_{k+1} = F x_k + G a_k, a_k ~ N(0, σ_a²),
+// G = [T²/2, T] (Bar-Shalom, Li & Kirubarajan 2001 §6.3.2); position measured with variance σ_w².
+struct Dwna {
+  Eigen::Matrix2d F, Q;
+  explicit Dwna(double T, double sigma_a) {
+    F << 1, T, 0, 1;
+    const Eigen::Vector2d G(T * T / 2, T);
+    Q = sigma_a * sigma_a * G * G.transpose();
+  }
+};
+
+}  // namespace
+
+TEST_CASE("Kalata gains and the steady-state covariance equal the converged Kalman filter of the DWNA model") {
+  const double sigma_w = 7.0;
+  for (double lambda : {0.05, 0.5, 2.0, 10.0}) {
+    for (double T : {0.1, 1.0, 3.0}) {
+      CAPTURE(lambda, T);
+      const Dwna model(T, lambda * sigma_w / (T * T));  // Λ = σ_a T² / σ_w
+      const double R = sigma_w * sigma_w;
+      Eigen::Matrix2d P = Eigen::Vector2d(R, 1e6).asDiagonal();
+      Eigen::Vector2d K = Eigen::Vector2d::Zero();
+      double S = 0;
+      for (int k = 0; k < 5000; ++k) {
+        const Eigen::Matrix2d Pp = model.F * P * model.F.transpose() + model.Q;
+        S = Pp(0, 0) + R;
+        K = Pp.col(0) / S;
+        P = Pp - K * K.transpose() * S;
+      }
+      const alpha_beta::Gains g = alpha_beta::gains_from_tracking_index(lambda);
+      CHECK(g.alpha == Approx(K(0)).epsilon(1e-9));
+      CHECK(g.beta == Approx(K(1) * T).epsilon(1e-9));
+      const alpha_beta::AxisCovariance c = alpha_beta::steady_state_covariance(g, T, R);
+      CHECK(c.s == Approx(S).epsilon(1e-9));
+      CHECK(c.p11 == Approx(P(0, 0)).epsilon(1e-9));
+      CHECK(c.p12 == Approx(P(0, 1)).epsilon(1e-9));
+      CHECK(c.p22 == Approx(P(1, 1)).epsilon(1e-9));
+      CHECK(alpha_beta::has_steady_state_covariance(g));
+      CHECK(alpha_beta::error_correlation_squared(g) == Approx(P(0, 1) * P(0, 1) / (P(0, 0) * P(1, 1))).epsilon(1e-6));
+    }
+  }
+}
+
+TEST_CASE("gains are accepted exactly where the steady-state covariance is positive definite") {
+  for (double alpha : {0.05, 0.1, 0.5, 0.9, 0.99}) {
+    const double b = alpha_beta::max_beta_for_covariance(alpha);
+    for (double beta : {0.5 * b, 0.99 * b, 1.01 * b, 1.5 * b}) {
+      CAPTURE(alpha, beta);
+      const auto c = alpha_beta::steady_state_covariance({alpha, beta}, 1.0, 1.0);
+      const double det = c.p11 * c.p22 - c.p12 * c.p12;
+      CHECK((det > 0 && c.p22 > 0) == (beta < b));
+      CHECK(alpha_beta::has_steady_state_covariance({alpha, beta}) == (beta < b));
+      if (det > 0) CHECK(alpha_beta::error_correlation_squared({alpha, beta}) == Approx(c.p12 * c.p12 / (c.p11 * c.p22)));
+    }
+  }
+  // On the bound itself the covariance is singular: refused even when rounding lands just below.
+  CHECK_FALSE(alpha_beta::has_steady_state_covariance({0.4, 0.2}));
+  CHECK_FALSE(alpha_beta::has_steady_state_covariance({0.5, alpha_beta::max_beta_for_covariance(0.5)}));
+}
+
+TEST_CASE("two-point start, then the alpha-beta recursion with the actual time step") {
+  const double alpha = 0.6, beta = 0.3;
+  auto f = make("{alpha: 0.6, beta: 0.3}");
+  Collector out;
+  out.attach_to(*f);
+  Diagnostics diag;
+  f->start_run({0, 1, &diag});
+  const Vec3 var(4.0, 9.0, 16.0);
+  const Vec3 z1(0, 0, 0), z2(10, 20, -5), z3(25, 35, -5);
+  f->on_measurement(cartesian(0.0, z1, var), 0);
+  f->on_measurement(cartesian(1.0, z2, var), 0);
+  f->on_measurement(cartesian(3.0, z3, var), 0);  // T = 2 s
+  REQUIRE(out.estimates.size() == 3);
+  CHECK_FALSE(out.estimates[0].initialised);
+  CHECK(out.estimates[0].enu.head<3>() == z1);
+  CHECK(out.estimates[1].initialised);
+  CHECK_FALSE(out.estimates[1].updated);
+  CHECK(out.estimates[1].enu.head<3>() == z2);
+  CHECK(out.estimates[1].enu.tail<3>() == z2 - z1);
+  // Two-point covariance: var(v) = (σ₁² + σ₂²)/T².
+  CHECK(out.estimates[1].enu_covariance(4, 4) == Approx(18.0));
+  CHECK(out.estimates[1].enu_covariance(1, 4) == Approx(9.0));
+
+  const Vec3 v2 = z2 - z1;
+  const Vec3 predicted = z2 + 2.0 * v2;
+  const Vec3 r = z3 - predicted;
+  const Vec3 x3 = predicted + alpha * r;
+  const Vec3 v3 = v2 + beta / 2.0 * r;
+  const Estimate& e = out.estimates[2];
+  CHECK(e.updated);
+  CHECK(e.time == 3.0);
+  for (int a = 0; a < 3; ++a) {
+    CAPTURE(a);
+    CHECK(e.enu(a) == Approx(x3(a)));
+    CHECK(e.enu(a + 3) == Approx(v3(a)));
+    CHECK(e.state(2 * a) == Approx(x3(a)));
+    CHECK(e.state(2 * a + 1) == Approx(v3(a)));
+    CHECK(e.innovation(a) == Approx(r(a)));
+    CHECK(e.innovation_covariance(a, a) == Approx(var(a) / (1 - alpha)));
+    CHECK(e.enu_covariance(a, a) == Approx(alpha * var(a)));
+    CHECK(e.enu_covariance(a, a + 3) == Approx(beta / 2.0 * var(a)));
+    CHECK(e.covariance(2 * a, 2 * a + 1) == Approx(beta / 2.0 * var(a)));
+    CHECK(e.covariance(2 * a + 1, 2 * a + 1) == Approx(e.enu_covariance(a + 3, a + 3)));
+  }
+  CHECK(e.enu_covariance(0, 1) == 0.0);
+  const double nis = (r.array().square() * (1 - alpha) / var.array()).sum();
+  CHECK(e.nis == Approx(nis));
+  CHECK(diag.warnings.empty());
+}
+
+TEST_CASE("default gains are alpha 0.5 and beta 0.2 and tracking_index gives the Kalata gains") {
+  struct Case {
+    std::string yaml;
+    alpha_beta::Gains expected;
+  };
+  for (const Case& c : {Case{"{}", {0.5, 0.2}}, Case{"{tracking_index: 0.8}", alpha_beta::gains_from_tracking_index(0.8)}}) {
+    CAPTURE(c.yaml);
+    auto f = make(c.yaml);
+    Collector out;
+    out.attach_to(*f);
+    Diagnostics diag;
+    f->start_run({0, 1, &diag});
+    f->on_measurement(cartesian(0.0, Vec3(0, 0, 0), Vec3::Ones()), 0);
+    f->on_measurement(cartesian(1.0, Vec3(1, 1, 1), Vec3::Ones()), 0);
+    f->on_measurement(cartesian(2.0, Vec3(3, 2, 2), Vec3::Ones()), 0);  // residual (1, 0, 0)
+    REQUIRE(out.estimates.size() == 3);
+    CHECK(out.estimates[2].enu(0) == Approx(2 + c.expected.alpha));
+    CHECK(out.estimates[2].enu(3) == Approx(1 + c.expected.beta));
+  }
+}
+
+TEST_CASE("a noiseless constant-velocity target is tracked exactly through irregular steps") {
+  auto f = make("{alpha: 0.3, beta: 0.05}");
+  Collector out;
+  out.attach_to(*f);
+  Diagnostics diag;
+  f->start_run({0, 1, &diag});
+  const Vec3 p0(1000, -2000, 300), v(-120, 45, 3);
+  double t = 0;
+  for (double step : {0.0, 0.5, 1.7, 0.1, 3.0, 0.9}) {
+    t += step;
+    f->on_measurement(cartesian(t, p0 + t * v, Vec3(25, 25, 100)), 0);
+  }
+  REQUIRE(out.estimates.size() == 6);
+  for (size_t k = 1; k < out.estimates.size(); ++k) {
+    const Estimate& e = out.estimates[k];
+    CHECK((e.enu.head<3>() - (p0 + e.time * v)).norm() < 1e-9);
+    CHECK((e.enu.tail<3>() - v).norm() < 1e-9);
+  }
+}
+
+TEST_CASE("Monte Carlo on a DWNA target: errors and NIS agree with the published covariance") {
+  const double T = 1.0, sigma_w = 10.0, lambda = 0.5, sigma_a = lambda * sigma_w / (T * T);
+  const int runs = 1500, steps = 40;
+  const Dwna model(T, sigma_a);
+  auto f = make("{tracking_index: 0.5}");
+  Collector out;
+  out.attach_to(*f);
+  Rng rng(20240611);
+  double pos = 0, vel = 0, nis = 0;  // sums of e²/p over runs and axes, and of NIS
+  for (int run = 0; run < runs; ++run) {
+    Diagnostics diag;
+    out.estimates.clear();
+    f->start_run({static_cast<std::uint64_t>(run), 1, &diag});
+    Eigen::Matrix<double, 2, 3> x;  // [position; velocity] per axis
+    x.row(0).setZero();
+    x.row(1) << 100, -50, 10;
+    for (int k = 0; k < steps; ++k) {
+      if (k > 0) {
+        for (int a = 0; a < 3; ++a) {
+          const double acc = rng.normal(0, sigma_a);
+          x.col(a) = (model.F * x.col(a)).eval() + Eigen::Vector2d(T * T / 2, T) * acc;
+        }
+      }
+      const Vec3 z(x(0, 0) + rng.normal(0, sigma_w), x(0, 1) + rng.normal(0, sigma_w), x(0, 2) + rng.normal(0, sigma_w));
+      f->on_measurement(cartesian(k * T, z, Vec3::Constant(sigma_w * sigma_w)), 0);
+    }
+    REQUIRE(out.estimates.size() == static_cast<size_t>(steps));
+    const Estimate& e = out.estimates.back();
+    for (int a = 0; a < 3; ++a) {
+      pos += std::pow(e.enu(a) - x(0, a), 2) / e.enu_covariance(a, a);
+      vel += std::pow(e.enu(a + 3) - x(1, a), 2) / e.enu_covariance(a + 3, a + 3);
+    }
+    nis += e.nis;
+  }
+  // Each normalised squared error is χ²(1): mean 1, variance 2; over n = 3·runs samples the
+  // mean has standard deviation √(2/n). NIS is χ²(3): mean 3, std of the mean √(6/runs).
+  const double n = 3.0 * runs;
+  CHECK(std::abs(pos / n - 1.0) < 5 * std::sqrt(2 / n));
+  CHECK(std::abs(vel / n - 1.0) < 5 * std::sqrt(2 / n));
+  CHECK(std::abs(nis / runs - 3.0) < 5 * std::sqrt(6.0 / runs));
+}
+
+TEST_CASE("bad parameters are refused naming the parameter") {
+  auto message = [](const std::string& yaml) {
+    try {
+      make(yaml);
+    } catch (const ConfigError& e) {
+      return e.message();
+    }
+    return std::string("no error");
+  };
+  CHECK_THAT(message("{alpha: 0.4}"), Catch::Contains("'alpha'") && Catch::Contains("beta"));
+  CHECK_THAT(message("{beta: 0.1}"), Catch::Contains("'beta'"));
+  CHECK_THAT(message("{alpha: 1, beta: 0.5}"), Catch::Contains("'alpha'") && Catch::Contains("between 0 and 1"));
+  CHECK_THAT(message("{alpha: 0.5, beta: 0}"), Catch::Contains("'beta'"));
+  CHECK_THAT(message("{alpha: 0.2, beta: 1.5}"), Catch::Contains("'beta'") && Catch::Contains("2 alpha^2 / (2 - alpha)"));
+  CHECK_THAT(message("{alpha: 0.4, beta: 0.2}"), Catch::Contains("singular"));  // exactly on the bound
+  CHECK_THAT(message("{alpha: 0.5, beta: 0.2, tracking_index: 1}"), Catch::Contains("not both"));
+  CHECK_THAT(message("{tracking_index: 0}"), Catch::Contains("tracking_index"));
+  CHECK_THAT(message("{tracking_index: 1 m}"), Catch::Contains("tracking_index"));
+  CHECK(message("{alpha: 0.5, beta: 0.2}") == "no error");
+}
+
+TEST_CASE("a spherical measurement is a configuration error naming the node") {
+  auto f = make("{}", "my_ab");
+  Diagnostics diag;
+  f->start_run({0, 1, &diag});
+  Measurement m = cartesian(0.0, Vec3(1000, 0.1, 0.02), Vec3::Ones());
+  m.frame = Frame::Spherical;
+  try {
+    f->on_measurement(m, 0);
+    FAIL("no error");
+  } catch (const ConfigError& e) {
+    CHECK_THAT(e.message(), Catch::Contains("my_ab") && Catch::Contains("convert.classical"));
+  }
+}
+
+TEST_CASE("a time step of zero or less skips the update with a warning and invalid measurements coast") {
+  auto f = make("{}", "ab");
+  Collector out;
+  out.attach_to(*f);
+  Diagnostics diag;
+  f->start_run({0, 1, &diag});
+  f->on_measurement(cartesian(0.0, Vec3(0, 0, 0), Vec3::Ones()), 0);
+  f->on_measurement(cartesian(1.0, Vec3(2, 0, 0), Vec3::Ones()), 0);
+  f->on_measurement(cartesian(1.0, Vec3(50, 0, 0), Vec3::Ones()), 0);  // same time
+  f->on_measurement(cartesian(0.5, Vec3(50, 0, 0), Vec3::Ones()), 0);  // older
+  REQUIRE(out.estimates.size() == 2);
+  REQUIRE(diag.warnings.size() == 2);
+  CHECK(diag.warnings[0].node == "ab");
+  CHECK_THAT(diag.warnings[0].message, Catch::Contains("not later"));
+
+  Measurement lost = cartesian(2.0, Vec3(0, 0, 0), Vec3::Ones());
+  lost.valid = false;
+  f->on_measurement(lost, 0);
+  REQUIRE(out.estimates.size() == 3);
+  const Estimate& e = out.estimates.back();
+  CHECK_FALSE(e.updated);
+  CHECK(e.innovation.size() == 0);
+  CHECK(e.enu(0) == Approx(4.0));  // 2 m + 1 s × 2 m/s
+  CHECK(e.enu_covariance(0, 0) > out.estimates[1].enu_covariance(0, 0));
+  CHECK(e.enu_covariance.allFinite());
+}

@@ -1,0 +1,319 @@
+// Purpose: tests of sink.csv: header and rows, values against the inputs, empty cells, run order, measurement rows, paths.
+#include <trackflow/geometry.hpp>
+
+#include <Eigen/Dense>
+#include <catch2/catch.hpp>
+
+#include <filesystem>
+#include <fstream>
+#include <functional>
+#include <sstream>
+#include <string>
+#include <unistd.h>
+
+#include "plugin_fixture.hpp"
+
+using namespace trackflow;
+namespace fs = std::filesystem;
+
+namespace {
+
+const InputInfo kKf{"kf", "filter.kalman", mask(ItemKind::Estimate)};
+const InputInfo kEkf{"ekf", "filter.ekf", mask(ItemKind::Estimate)};
+const InputInfo kTruth{"truth", "sim.trajectory", mask(ItemKind::Truth)};
+const InputInfo kCm{"cm", "convert.classical", mask(ItemKind::Measurement)};
+
+const std::string kHeader =
+    "run,time,source,kind,updated,x,y,z,vx,vy,vz,sigma_x,sigma_y,sigma_z,sigma_vx,sigma_vy,sigma_vz,nis,nees,"
+    "truth_x,truth_y,truth_z,truth_vx,truth_vy,truth_vz";
+enum Col { Run, Time, Source, Kind, Updated, X, Y, Z, VX, VY, VZ, SX, SY, SZ, SVX, SVY, SVZ, Nis, Nees, TX, TY, TZ, TVX, TVY, TVZ };
+
+// A folder of this test process, removed when the process exits.
+const fs::path& scratch_root() {
+  struct Root {
+    fs::path path = fs::temp_directory_path() / ("trackflow_test_sink_csv_" + std::to_string(::getpid()));
+    ~Root() {
+      std::error_code ec;
+      fs::remove_all(path, ec);
+    }
+  };
+  static const Root root;
+  return root.path;
+}
+
+fs::path scratch(const std::string& name) {
+  const fs::path p = scratch_root() / name;
+  fs::remove_all(p);
+  return p;
+}
+
+std::string slurp(const fs::path& p) {
+  std::ifstream is(p, std::ios::binary);
+  std::stringstream ss;
+  ss << is.rdbuf();
+  return ss.str();
+}
+
+std::vector<std::vector<std::string>> parse(const std::string& text) {
+  std::vector<std::vector<std::string>> rows;
+  std::istringstream is(text);
+  std::string line;
+  while (std::getline(is, line)) {
+    std::vector<std::string> cells;
+    size_t start = 0;
+    for (;;) {
+      const size_t comma = line.find(',', start);
+      cells.push_back(line.substr(start, comma - start));
+      if (comma == std::string::npos) break;
+      start = comma + 1;
+    }
+    rows.push_back(cells);
+  }
+  return rows;
+}
+
+Truth truth(double t, Vec3 p, Vec3 v) {
+  Truth x;
+  x.time = t;
+  x.position = p;
+  x.velocity = v;
+  return x;
+}
+
+Estimate estimate(double t, const Vec6& enu, const Mat6& cov, bool updated = true) {
+  Estimate e;
+  e.time = t;
+  e.initialised = true;
+  e.updated = updated;
+  e.enu = enu;
+  e.enu_covariance = cov;
+  if (updated) {
+    e.innovation.resize(3);
+    e.innovation << 1, 2, 3;
+    e.nis = 2.5 + t;
+  }
+  return e;
+}
+
+Mat6 covariance() {
+  Mat6 P = Mat6::Zero();
+  P.diagonal() << 4, 9, 16, 0.25, 1, 2.25;
+  P(0, 1) = P(1, 0) = 1.5;
+  return P;
+}
+
+// One run: truth on port 2, filter kf on port 0, filter ekf on port 1; two steps, the second
+// with its truth delivered after the estimates when `truth_last` is set.
+void feed(Component& c, std::uint64_t run, bool truth_last = false) {
+  for (int k = 0; k < 2; ++k) {
+    const double t = 0.5 * k;
+    const Truth tr = truth(t, Vec3(1000 + 10.0 * run, 2000 + k, 300), Vec3(-100, 50, 0));
+    Vec6 x;
+    x << tr.position, tr.velocity;
+    if (!truth_last) c.on_truth(tr, 2);
+    c.on_estimate(estimate(t, x + Vec6::Constant(1.0), covariance()), 0);
+    c.on_estimate(estimate(t, x + Vec6::Constant(-2.0), covariance(), k == 0), 1);
+    if (truth_last) c.on_truth(tr, 2);
+  }
+}
+
+std::shared_ptr<Component> make_csv(const std::string& params, const std::vector<InputInfo>& inputs = {kKf, kEkf, kTruth}) {
+  auto c = test::make("sink.csv", params, "log");
+  c->set_inputs(inputs);
+  return c;
+}
+
+// Runs `runs` runs, run r on worker `assign(r)`, in the order `order`; merges in run order.
+std::string ensemble_file(const fs::path& dir, const std::vector<std::uint64_t>& order, int workers,
+                          const std::function<int(std::uint64_t)>& assign, bool truth_last = false) {
+  std::vector<std::shared_ptr<Component>> pool;
+  for (int w = 0; w < workers; ++w) pool.push_back(make_csv("{}"));
+  auto aggregate = make_csv("{}");
+  std::vector<std::unique_ptr<RunResult>> results(order.size());
+  Diagnostics diag;
+  for (std::uint64_t r : order) {
+    Component& c = *pool[static_cast<size_t>(assign(r))];
+    c.start_run({r, 99, &diag});
+    feed(c, r, truth_last);
+    results[r] = c.end_run();
+  }
+  for (auto& r : results) aggregate->merge(*r);
+  Summary s;
+  aggregate->finish(s, {"log", dir.string(), order.size()});
+  REQUIRE(s.files.size() == 1);
+  CHECK(s.files[0] == (dir / "log.csv").string());
+  return slurp(dir / "log.csv");
+}
+
+double num(const std::string& cell) { return std::stod(cell); }
+
+}  // namespace
+
+TEST_CASE("the file has the header, one row per estimate and run, 25 cells each, no nan") {
+  const fs::path dir = scratch("basic") / "nested";  // --out need not exist yet
+  const std::string text = ensemble_file(dir, {0, 1, 2}, 1, [](std::uint64_t) { return 0; });
+  const auto rows = parse(text);
+  REQUIRE(rows.size() == 1 + 3 * 4);
+  CHECK(text.substr(0, text.find('\n')) == kHeader);
+  for (const auto& r : rows) CHECK(r.size() == 25);
+  CHECK(text.find("nan") == std::string::npos);
+  CHECK(text.find("inf") == std::string::npos);
+  // Run column, then arrival order within a run.
+  CHECK(rows[1][Run] == "0");
+  CHECK(rows[5][Run] == "1");
+  CHECK(rows[12][Run] == "2");
+  CHECK(rows[1][Source] == "kf");
+  CHECK(rows[2][Source] == "ekf");
+  CHECK(rows[1][Kind] == "estimate");
+}
+
+TEST_CASE("cells hold the estimate, its sigmas, NIS, NEES and the matching truth") {
+  const fs::path dir = scratch("values");
+  const auto rows = parse(ensemble_file(dir, {0, 1}, 1, [](std::uint64_t) { return 0; }));
+  // Run 1, step 1, filter kf: truth (1010, 2001, 300, -100, 50, 0), error +1 everywhere.
+  const auto& r = rows[7];
+  REQUIRE(r[Run] == "1");
+  CHECK(num(r[Time]) == 0.5);
+  CHECK(r[Updated] == "1");
+  CHECK(num(r[X]) == Approx(1011));
+  CHECK(num(r[Y]) == Approx(2002));
+  CHECK(num(r[VZ]) == Approx(1));
+  CHECK(num(r[SX]) == Approx(2));
+  CHECK(num(r[SY]) == Approx(3));
+  CHECK(num(r[SVZ]) == Approx(1.5));
+  CHECK(num(r[Nis]) == Approx(3.0));
+  const Vec6 e = Vec6::Constant(1.0);
+  CHECK(num(r[Nees]) == Approx(e.dot(covariance().inverse() * e)).epsilon(1e-8));
+  CHECK(num(r[TX]) == Approx(1010));
+  CHECK(num(r[TY]) == Approx(2001));
+  CHECK(num(r[TVX]) == Approx(-100));
+  // The ekf's coasting step: updated 0 and an empty NIS cell.
+  const auto& coast = rows[8];
+  REQUIRE(coast[Source] == "ekf");
+  CHECK(coast[Updated] == "0");
+  CHECK(coast[Nis].empty());
+  CHECK(!coast[Nees].empty());
+}
+
+TEST_CASE("cells without a value are empty: no truth at that time, non-positive covariance") {
+  const fs::path dir = scratch("empty");
+  auto c = make_csv("{}");
+  Diagnostics diag;
+  c->start_run({0, 1, &diag});
+  c->on_truth(truth(0.0, Vec3(1, 2, 3), Vec3::Zero()), 2);
+  Mat6 bad = Mat6::Identity();
+  bad(2, 2) = -1.0;  // sigma_z undefined, NEES undefined
+  c->on_estimate(estimate(0.0, Vec6::Zero(), bad), 0);
+  c->on_estimate(estimate(0.3, Vec6::Zero(), Mat6::Identity()), 0);  // no truth sample at 0.3
+  Estimate early = estimate(0.4, Vec6::Zero(), Mat6::Identity());
+  early.initialised = false;  // not written
+  c->on_estimate(early, 0);
+  c->on_truth(truth(1.0, Vec3(1, 2, 3), Vec3::Zero()), 2);
+  auto result = c->end_run();
+  c->merge(*result);
+  Summary s;
+  c->finish(s, {"log", dir.string(), 1});
+  const std::string text = slurp(dir / "log.csv");
+  CHECK(text.find("nan") == std::string::npos);
+  const auto rows = parse(text);
+  REQUIRE(rows.size() == 3);
+  CHECK(rows[1][SZ].empty());
+  CHECK(num(rows[1][SX]) == 1.0);
+  CHECK(rows[1][Nees].empty());
+  CHECK(num(rows[1][TZ]) == 3.0);
+  for (int col : {Nees, TX, TY, TZ, TVX, TVY, TVZ}) CHECK(rows[2][col].empty());
+  CHECK(!rows[2][Nis].empty());
+  CHECK(s.find("rows")->value == 2);
+}
+
+TEST_CASE("the file is byte-identical whatever the worker assignment, run order and item order within a step") {
+  const std::string serial = ensemble_file(scratch("serial"), {0, 1, 2, 3}, 1, [](std::uint64_t) { return 0; });
+  const std::string interleaved = ensemble_file(scratch("two"), {0, 1, 2, 3}, 2, [](std::uint64_t r) { return int(r % 2); });
+  const std::string reversed = ensemble_file(scratch("rev"), {3, 1, 2, 0}, 3, [](std::uint64_t r) { return int(r % 3); });
+  const std::string truth_last = ensemble_file(scratch("late"), {0, 1, 2, 3}, 1, [](std::uint64_t) { return 0; }, true);
+  CHECK(parse(serial).size() == 1 + 4 * 4);
+  CHECK(interleaved == serial);
+  CHECK(reversed == serial);
+  CHECK(truth_last == serial);
+}
+
+TEST_CASE("measurement rows: Cartesian position, sigmas when Cartesian, truth, no filter columns") {
+  const fs::path dir = scratch("meas");
+  auto c = make_csv("{ include_measurements: true, precision: 12 }", {kKf, kTruth, kCm});
+  Diagnostics diag;
+  c->start_run({0, 1, &diag});
+  const Vec3 p(3000, 4000, 500);
+  c->on_truth(truth(0.0, p, Vec3(1, 2, 3)), 1);
+  Measurement cart;
+  cart.frame = Frame::Cartesian;
+  cart.value.resize(4);  // with range rate: only x, y, z are a position
+  cart.value << 3001, 4002, 503, -7;
+  cart.covariance = MeasCov::Zero(4, 4);
+  cart.covariance.diagonal() << 4, 9, 16, 1;
+  c->on_measurement(cart, 2);
+  Measurement sph;
+  sph.frame = Frame::Spherical;
+  sph.azimuth = AzimuthConvention::XCounterClockwise;
+  sph.sensor_position = Vec3(100, 200, 0);
+  const Vec3 d = p - sph.sensor_position;
+  sph.value.resize(3);
+  sph.value << d.norm(), std::atan2(d.y(), d.x()), std::asin(d.z() / d.norm());
+  sph.covariance = MeasCov::Identity(3, 3);
+  c->on_measurement(sph, 2);
+  Measurement invalid = cart;
+  invalid.valid = false;
+  c->on_measurement(invalid, 2);
+  auto result = c->end_run();
+  c->merge(*result);
+  Summary s;
+  c->finish(s, {"log", dir.string(), 1});
+  const auto rows = parse(slurp(dir / "log.csv"));
+  REQUIRE(rows.size() == 3);
+  const auto& a = rows[1];
+  CHECK(a[Source] == "cm");
+  CHECK(a[Kind] == "measurement");
+  CHECK(a[Updated].empty());
+  CHECK(num(a[X]) == 3001);
+  CHECK(num(a[Z]) == 503);
+  CHECK(num(a[SX]) == 2);
+  CHECK(num(a[SZ]) == 4);
+  for (int col : {VX, VY, VZ, SVX, SVY, SVZ, Nis, Nees}) CHECK(a[col].empty());
+  CHECK(num(a[TX]) == 3000);
+  CHECK(num(a[TVZ]) == 3);
+  const auto& b = rows[2];
+  CHECK(num(b[X]) == Approx(3000).margin(1e-6));
+  CHECK(num(b[Y]) == Approx(4000).margin(1e-6));
+  CHECK(num(b[Z]) == Approx(500).margin(1e-6));
+  CHECK(b[SX].empty());
+
+  // Off by default.
+  auto quiet = make_csv("{}", {kKf, kTruth, kCm});
+  quiet->start_run({0, 1, &diag});
+  quiet->on_measurement(cart, 2);
+  auto none = quiet->end_run();
+  quiet->merge(*none);
+  Summary s2;
+  quiet->finish(s2, {"log", (dir / "quiet").string(), 1});
+  CHECK(parse(slurp(dir / "quiet" / "log.csv")).size() == 1);
+  CHECK(s2.find("rows")->value == 0);
+}
+
+TEST_CASE("path is relative to the output folder; precision sets significant digits") {
+  const fs::path dir = scratch("path");
+  auto c = make_csv("{ path: sub/run.csv, precision: 4 }", {kKf});
+  Diagnostics diag;
+  c->start_run({0, 1, &diag});
+  c->on_estimate(estimate(3.14159265, Vec6::Constant(123456.789), Mat6::Identity()), 0);
+  auto result = c->end_run();
+  c->merge(*result);
+  Summary s;
+  c->finish(s, {"log", dir.string(), 1});
+  REQUIRE(s.files.size() == 1);
+  CHECK(s.files[0] == (dir / "sub" / "run.csv").string());
+  const auto rows = parse(slurp(dir / "sub" / "run.csv"));
+  REQUIRE(rows.size() == 2);
+  CHECK(rows[1][Time] == "3.142");
+  CHECK(rows[1][X] == "1.235e+05");
+  CHECK(rows[1][TX].empty());
+  CHECK_THROWS_AS(test::make("sink.csv", "{ precision: 0 }"), ConfigError);
+}

@@ -1,0 +1,232 @@
+// Purpose: sink.metrics' run-ordered accumulation and the ensemble report (RMSE, bias, ANEES, ANIS with chi-square bands).
+#include "ensemble.hpp"
+
+#include "chi_square_band.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <string>
+
+namespace trackflow::metrics {
+
+void Ensemble::add(const MetricsRunResult& run) {
+  ++runs;
+  runs_with_truth += run.had_truth ? 1 : 0;
+  before_window += run.before_window;
+  non_finite += run.non_finite;
+  unmatched += run.unmatched;
+  not_positive_definite += run.not_positive_definite;
+  measurement_sq_error += run.measurement_sq_error;
+  measurements_matched += run.measurements_matched;
+  measurements_unmatched += run.measurements_unmatched;
+  for (const EstimateRecord& r : run.records) {
+    ++estimates;
+    StepSums& s = steps[r.key];
+    ++s.estimates;
+    if (r.matched) {
+      ++s.matched;
+      for (int i = 0; i < 6; ++i) {
+        s.sq[i] += r.error(i) * r.error(i);
+        s.sum[i] += r.error(i);
+      }
+    }
+    if (r.has_nees) {
+      ++s.nees_count;
+      s.nees += r.nees;
+      s.nees_position += r.nees_position;
+    }
+    if (r.nis_dof > 0) {
+      ++s.nis_count;
+      s.nis_dof += static_cast<std::uint64_t>(r.nis_dof);
+      s.nis += r.nis;
+      nis_dof_min = std::min(nis_dof_min, r.nis_dof);
+      nis_dof_max = std::max(nis_dof_max, r.nis_dof);
+      for (int i = 0; i < r.nis_dof; ++i) {
+        innovation_sum[i] += r.innovation(i);
+        ++innovation_count[i];
+      }
+    }
+  }
+}
+
+namespace {
+
+std::string count_text(std::uint64_t n, const char* what) {
+  return std::to_string(n) + " " + what + (n == 1 ? "" : "s");
+}
+
+std::string seconds_text(double v) {
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%g s", v);
+  return buf;
+}
+
+// Never lets a NaN or infinity reach the summary: it becomes a note instead.
+void put(Summary& s, const std::string& name, double v, const char* unit = "") {
+  if (std::isfinite(v))
+    s.metric(name, v, unit);
+  else
+    s.notes.push_back(name + " not reported: its value is not finite (a diverged estimate?)");
+}
+void put_band(Summary& s, const std::string& name, double v, Band b, double confidence) {
+  if (std::isfinite(v) && std::isfinite(b.lo) && std::isfinite(b.hi))
+    s.metric_band(name, v, b.lo, b.hi, confidence);
+  else
+    s.notes.push_back(name + " not reported: its value is not finite (a diverged estimate?)");
+}
+
+// Mean over steps of the per-step average NIS, and the band for `dof`-dimensional innovations
+// over the ensemble's runs.
+void report_anis(const Ensemble& e, const ReportOptions& opt, Summary& s) {
+  double total = 0.0;
+  std::uint64_t n = 0;
+  for (const auto& [key, st] : e.steps) {
+    if (st.nis_count == 0) continue;
+    total += st.nis / static_cast<double>(st.nis_dof);
+    ++n;
+  }
+  if (n == 0) {
+    s.notes.push_back("anis not reported: no updated estimate carries an innovation");
+    return;
+  }
+  int dof = e.nis_dof_max;
+  if (e.nis_dof_min != e.nis_dof_max) {
+    std::uint64_t dof_sum = 0, count = 0;
+    for (const auto& [key, st] : e.steps) {
+      dof_sum += st.nis_dof;
+      count += st.nis_count;
+    }
+    dof = static_cast<int>(std::lround(static_cast<double>(dof_sum) / static_cast<double>(count)));
+    s.notes.push_back("anis: innovation dimension varies between " + std::to_string(e.nis_dof_min) + " and " +
+                      std::to_string(e.nis_dof_max) + "; its band uses the mean dimension " + std::to_string(dof));
+  }
+  put_band(s, "anis", total / static_cast<double>(n),
+           chi_square_band(static_cast<double>(dof) * static_cast<double>(e.runs), opt.confidence), opt.confidence);
+}
+
+void report_errors(const Ensemble& e, Summary& s, double& position_rmse) {
+  std::uint64_t matched = 0;
+  double sq[6] = {}, sum[6] = {};
+  double max_rms = 0.0;
+  for (const auto& [key, st] : e.steps) {
+    if (st.matched == 0) continue;
+    matched += st.matched;
+    for (int i = 0; i < 6; ++i) {
+      sq[i] += st.sq[i];
+      sum[i] += st.sum[i];
+    }
+    max_rms = std::max(max_rms, std::sqrt((st.sq[0] + st.sq[1] + st.sq[2]) / static_cast<double>(st.matched)));
+  }
+  if (matched == 0) {
+    s.notes.push_back("error metrics not reported: no estimate could be matched to truth" +
+                      std::string(e.estimates ? " (all are outside the truth's time span)" : " (no estimates)"));
+    return;
+  }
+  const double N = static_cast<double>(matched);
+  position_rmse = std::sqrt((sq[0] + sq[1] + sq[2]) / N);
+  put(s, "position_rmse", position_rmse, "m");
+  put(s, "position_rmse_x", std::sqrt(sq[0] / N), "m");
+  put(s, "position_rmse_y", std::sqrt(sq[1] / N), "m");
+  put(s, "position_rmse_z", std::sqrt(sq[2] / N), "m");
+  put(s, "velocity_rmse", std::sqrt((sq[3] + sq[4] + sq[5]) / N), "m/s");
+  put(s, "velocity_rmse_x", std::sqrt(sq[3] / N), "m/s");
+  put(s, "velocity_rmse_y", std::sqrt(sq[4] / N), "m/s");
+  put(s, "velocity_rmse_z", std::sqrt(sq[5] / N), "m/s");
+  put(s, "mean_error_x", sum[0] / N, "m");
+  put(s, "mean_error_y", sum[1] / N, "m");
+  put(s, "mean_error_z", sum[2] / N, "m");
+  put(s, "max_position_error_rms", max_rms, "m");
+}
+
+// ANEES_k = (sum over runs of NEES at step k) / (n M_k); reported is its mean over steps with
+// the per-step band for all M runs, plus the fraction of steps inside their own (M_k) band.
+void report_nees(const Ensemble& e, const ReportOptions& opt, Summary& s) {
+  double total = 0.0, total_position = 0.0;
+  std::uint64_t n = 0, in_band = 0;
+  std::map<std::uint64_t, Band> band_for_runs;  // quantiles are costly; steps share few M_k values
+  for (const auto& [key, st] : e.steps) {
+    if (st.nees_count == 0) continue;
+    const double anees_k = st.nees / (6.0 * static_cast<double>(st.nees_count));
+    auto it = band_for_runs.find(st.nees_count);
+    if (it == band_for_runs.end())
+      it = band_for_runs.emplace(st.nees_count, chi_square_band(6.0 * static_cast<double>(st.nees_count), opt.confidence)).first;
+    in_band += anees_k >= it->second.lo && anees_k <= it->second.hi ? 1 : 0;
+    total += anees_k;
+    total_position += st.nees_position / (3.0 * static_cast<double>(st.nees_count));
+    ++n;
+  }
+  if (n == 0) {
+    s.notes.push_back(e.not_positive_definite
+                          ? "anees not reported: no matched estimate has a positive-definite covariance"
+                          : "anees not reported: no estimate could be matched to truth");
+    return;
+  }
+  const double M = static_cast<double>(e.runs);
+  put_band(s, "anees", total / static_cast<double>(n), chi_square_band(6.0 * M, opt.confidence), opt.confidence);
+  put_band(s, "anees_position", total_position / static_cast<double>(n), chi_square_band(3.0 * M, opt.confidence),
+           opt.confidence);
+  put(s, "anees_steps_in_band", static_cast<double>(in_band) / static_cast<double>(n));
+  if (e.not_positive_definite)
+    s.notes.push_back("anees: left out " + count_text(e.not_positive_definite, "matched estimate") +
+                      " whose covariance is not positive definite");
+}
+
+void report_measurements(const Ensemble& e, Summary& s, double position_rmse) {
+  if (e.measurements_matched == 0) {
+    s.notes.push_back("measurement_position_rmse not reported: no measurement could be matched to truth" +
+                      std::string(e.measurements_unmatched ? " (outside its time span, or truth holds several targets)"
+                                                           : " (no valid measurements)"));
+    return;
+  }
+  const double rmse = std::sqrt(e.measurement_sq_error / static_cast<double>(e.measurements_matched));
+  put(s, "measurement_position_rmse", rmse, "m");
+  if (position_rmse >= 0.0 && rmse > 0.0)
+    put(s, "rmse_ratio", position_rmse / rmse);
+  else if (position_rmse >= 0.0)
+    s.notes.push_back("rmse_ratio not reported: the measurement position RMSE is zero");
+  if (e.measurements_unmatched)
+    s.notes.push_back("measurement_position_rmse: " + count_text(e.measurements_unmatched, "measurement") +
+                      " could not be matched to truth");
+}
+
+}  // namespace
+
+void report(const Ensemble& e, const ReportOptions& opt, Summary& s) {
+  if (e.runs == 0) {
+    s.notes.push_back("no runs were merged: nothing to report");
+    return;
+  }
+  const bool truth_mode = opt.truth_input || e.runs_with_truth > 0;
+  std::uint64_t steps = 0;
+  for (const auto& [key, st] : e.steps) steps += (truth_mode ? st.matched : st.estimates) > 0 ? 1 : 0;
+
+  if (truth_mode) {
+    double position_rmse = -1.0;
+    report_errors(e, s, position_rmse);
+    report_nees(e, opt, s);
+    report_anis(e, opt, s);
+    if (opt.measurement_input) report_measurements(e, s, position_rmse);
+    put(s, "estimates", static_cast<double>(e.estimates));
+    put(s, "unmatched_estimates", static_cast<double>(e.unmatched));
+    if (e.unmatched)
+      s.notes.push_back(count_text(e.unmatched, "estimate") +
+                        " lie outside the truth's time span and are left out of the error metrics");
+  } else {
+    s.notes.push_back("no truth input: only innovation statistics are reported (errors and NEES need truth)");
+    report_anis(e, opt, s);
+    for (int i = 0; i < kMaxMeasDim; ++i)
+      if (e.innovation_count[i])
+        put(s, "mean_innovation_" + std::to_string(i), e.innovation_sum[i] / static_cast<double>(e.innovation_count[i]));
+    put(s, "estimates", static_cast<double>(e.estimates));
+  }
+  put(s, "runs", static_cast<double>(e.runs));
+  put(s, "steps", static_cast<double>(steps));
+  if (e.before_window)
+    s.notes.push_back("left out " + count_text(e.before_window, "estimate") + " earlier than the first estimate + " +
+                      "skip_initial (" + seconds_text(opt.skip_initial) + ")");
+  if (e.non_finite)
+    s.notes.push_back("left out " + count_text(e.non_finite, "estimate") + " with a non-finite state (diverged filter)");
+}
+
+}  // namespace trackflow::metrics

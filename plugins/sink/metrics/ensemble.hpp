@@ -1,0 +1,71 @@
+// Purpose: sink.metrics' per-run records and their run-ordered accumulation per time step.
+#pragma once
+
+#include <trackflow/component.hpp>
+
+#include <cstdint>
+#include <map>
+#include <vector>
+
+namespace trackflow::metrics {
+
+using InnovationVec = Eigen::Matrix<double, kMaxMeasDim, 1>;
+
+// One evaluated estimate of one run.
+struct EstimateRecord {
+  long long key = 0;        // llround(time / time_tolerance): the time step across runs
+  bool matched = false;     // a truth state exists at this time
+  bool has_nees = false;    // matched and the covariance is positive definite
+  Vec6 error = Vec6::Zero();  // estimate - truth, ENU [position; velocity]
+  double nees = 0.0, nees_position = 0.0;
+  int nis_dof = 0;          // innovation dimension; 0 when the estimate was not updated
+  double nis = 0.0;
+  InnovationVec innovation = InnovationVec::Zero();
+};
+
+struct MetricsRunResult final : RunResult {
+  std::vector<EstimateRecord> records;
+  bool had_truth = false;
+  std::uint64_t before_window = 0;          // earlier than first estimate + skip_initial
+  std::uint64_t non_finite = 0;             // estimates whose ENU state or time is not finite
+  std::uint64_t unmatched = 0;              // outside the truth's time span (or no truth)
+  std::uint64_t not_positive_definite = 0;  // matched, but NEES undefined
+  // Measurement baseline of this run (a sum over one run is fixed by the run's own item order).
+  double measurement_sq_error = 0.0;
+  std::uint64_t measurements_matched = 0, measurements_unmatched = 0;
+};
+
+struct StepSums {
+  std::uint64_t estimates = 0, matched = 0;
+  double sq[6] = {};   // sum of squared errors per ENU component
+  double sum[6] = {};  // sum of errors (bias)
+  std::uint64_t nees_count = 0;
+  double nees = 0.0, nees_position = 0.0;
+  std::uint64_t nis_count = 0, nis_dof = 0;
+  double nis = 0.0;
+};
+
+// Everything merge() accumulates; add() must be called in run order for reproducible sums.
+struct Ensemble {
+  std::map<long long, StepSums> steps;
+  std::uint64_t runs = 0, runs_with_truth = 0;
+  std::uint64_t estimates = 0, before_window = 0, non_finite = 0, unmatched = 0, not_positive_definite = 0;
+  double measurement_sq_error = 0.0;
+  std::uint64_t measurements_matched = 0, measurements_unmatched = 0;
+  double innovation_sum[kMaxMeasDim] = {};
+  std::uint64_t innovation_count[kMaxMeasDim] = {};
+  int nis_dof_min = kMaxMeasDim + 1, nis_dof_max = 0;
+
+  void add(const MetricsRunResult& run);
+};
+
+struct ReportOptions {
+  double confidence = 0.95;
+  double skip_initial = 0.0;
+  bool truth_input = false;        // a truth stream is wired (or arrived)
+  bool measurement_input = false;  // a measurement stream is wired
+};
+
+void report(const Ensemble& e, const ReportOptions& opt, Summary& summary);
+
+}  // namespace trackflow::metrics

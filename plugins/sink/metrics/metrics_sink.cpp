@@ -1,0 +1,210 @@
+// Purpose: sink.metrics — ensemble RMSE, bias, ANEES and ANIS (with chi-square bands) of one filter against truth.
+#include "ensemble.hpp"
+#include "truth_match.hpp"
+
+#include <trackflow/geometry.hpp>
+#include <trackflow/plugin.hpp>
+
+#include <Eigen/Cholesky>
+
+#include <cmath>
+#include <limits>
+
+namespace trackflow {
+namespace {
+
+using metrics::EstimateRecord;
+using metrics::MetricsRunResult;
+
+// Items are only stored during a run; everything is evaluated in end_run(), when the truth of
+// the whole run is known (truth of a time step may arrive after the estimate of that step).
+class MetricsSink final : public Component {
+ public:
+  explicit MetricsSink(const Params& p)
+      : skip_initial_(p.real("skip_initial")), confidence_(p.real("confidence")), tolerance_(p.real("time_tolerance")) {
+    if (!(confidence_ > 0.0 && confidence_ < 1.0))
+      throw p.error("confidence", "must lie strictly between 0 and 1 (e.g. 0.95)");
+    constexpr size_t kReserve = 4096;
+    truth_.reserve(kReserve);
+    estimates_.reserve(kReserve);
+    measurements_.reserve(kReserve);
+  }
+
+  void set_inputs(const std::vector<InputInfo>& inputs) override {
+    std::string estimate_sources;
+    int estimate_inputs = 0;
+    for (const auto& in : inputs) {
+      if (in.kinds & mask(ItemKind::Estimate)) {
+        estimate_sources += (estimate_inputs++ ? ", '" : "'") + in.node + "'";
+      }
+      truth_input_ |= (in.kinds & mask(ItemKind::Truth)) != 0;
+      measurement_input_ |= (in.kinds & mask(ItemKind::Measurement)) != 0;
+    }
+    if (estimate_inputs > 1)
+      throw ConfigError("inputs " + estimate_sources +
+                        " all deliver estimates, but the metrics of one filter are computed per node: "
+                        "use one sink.metrics per filter");
+  }
+
+  void start_run(const RunContext&) override {
+    truth_.clear();
+    estimates_.clear();
+    measurements_.clear();
+  }
+
+  void on_truth(const Truth& t, int) override { metrics::insert_truth(truth_, t); }
+
+  void on_estimate(const Estimate& e, int) override {
+    if (!e.initialised) return;
+    estimates_.push_back({e.time, e.target, e.updated, e.nis, e.enu, e.enu_covariance, e.innovation});
+  }
+
+  void on_measurement(const Measurement& m, int) override {
+    if (!m.valid || m.value.size() < 3) return;
+    const Vec3 p = m.frame == Frame::Cartesian
+                       ? Vec3(m.value.head<3>())
+                       : Vec3(spherical_to_enu(m.value(0), m.value(1), m.value(2), m.azimuth) + m.sensor_position);
+    measurements_.push_back({m.time, p});
+  }
+
+  std::unique_ptr<RunResult> end_run() override {
+    auto r = std::make_unique<MetricsRunResult>();
+    r->had_truth = !truth_.empty();
+    r->records.reserve(estimates_.size());
+    const double start = window_start();
+    for (const StoredEstimate& e : estimates_) {
+      if (e.time + tolerance_ < start) {
+        ++r->before_window;
+        continue;
+      }
+      if (!e.enu.allFinite() || !std::isfinite(e.time)) {
+        ++r->non_finite;
+        continue;
+      }
+      r->records.push_back(evaluate(e, *r));
+    }
+    measurement_errors(start, *r);
+    return r;
+  }
+
+  void merge(RunResult& result) override { ensemble_.add(static_cast<MetricsRunResult&>(result)); }
+
+  void finish(Summary& summary, const FinishContext&) override {
+    metrics::report(ensemble_, {confidence_, skip_initial_, truth_input_, measurement_input_}, summary);
+  }
+
+ private:
+  struct StoredEstimate {
+    double time;
+    std::uint32_t target;
+    bool updated;
+    double nis;
+    Vec6 enu;
+    Mat6 covariance;
+    MeasVec innovation;
+  };
+  struct StoredMeasurement {
+    double time;
+    Vec3 position;
+  };
+
+  // The transient to leave out is measured from the first initialised estimate; a run without
+  // estimates (a measurement-only baseline) starts at its first measurement.
+  double window_start() const {
+    double first = std::numeric_limits<double>::infinity();
+    for (const auto& e : estimates_) first = std::min(first, e.time);
+    if (!std::isfinite(first))
+      for (const auto& m : measurements_) first = std::min(first, m.time);
+    return first + skip_initial_;
+  }
+
+  EstimateRecord evaluate(const StoredEstimate& e, MetricsRunResult& r) const {
+    EstimateRecord rec;
+    rec.key = std::llround(e.time / tolerance_);
+    const int m = static_cast<int>(e.innovation.size());
+    if (e.updated && m > 0 && std::isfinite(e.nis)) {
+      rec.nis_dof = m;
+      rec.nis = e.nis;
+      rec.innovation.head(m) = e.innovation;
+    }
+    Vec6 truth;
+    if (!metrics::truth_at(metrics::truth_for(truth_, e.target), e.time, tolerance_, truth)) {
+      ++r.unmatched;
+      return rec;
+    }
+    rec.matched = true;
+    rec.error = e.enu - truth;
+    // LLT rejects non-positive pivots but lets NaN through, hence the finiteness checks.
+    const Eigen::LLT<Mat6> full(e.covariance);
+    const Eigen::LLT<Mat3> position(e.covariance.topLeftCorner<3, 3>());
+    if (e.covariance.allFinite() && full.info() == Eigen::Success && position.info() == Eigen::Success) {
+      rec.nees = full.matrixL().solve(rec.error).squaredNorm();
+      rec.nees_position = position.matrixL().solve(rec.error.head<3>()).squaredNorm();
+      rec.has_nees = std::isfinite(rec.nees) && std::isfinite(rec.nees_position);
+    }
+    if (!rec.has_nees) ++r.not_positive_definite;
+    return rec;
+  }
+
+  void measurement_errors(double start, MetricsRunResult& r) const {
+    // Measurements carry a sensor, not a target, so they can only be scored against a single truth target.
+    const bool usable = metrics::single_target(truth_);
+    const metrics::TruthSpan span = metrics::truth_for(truth_, 0);
+    for (const auto& m : measurements_) {
+      if (m.time + tolerance_ < start) continue;
+      Vec6 truth;
+      if (usable && metrics::truth_at(span, m.time, tolerance_, truth)) {
+        r.measurement_sq_error += (m.position - truth.head<3>()).squaredNorm();
+        ++r.measurements_matched;
+      } else {
+        ++r.measurements_unmatched;
+      }
+    }
+  }
+
+  const double skip_initial_, confidence_, tolerance_;
+  bool truth_input_ = false, measurement_input_ = false;
+  std::vector<Truth> truth_;
+  std::vector<StoredEstimate> estimates_;
+  std::vector<StoredMeasurement> measurements_;
+  metrics::Ensemble ensemble_;
+};
+
+void register_components(Registrar& r) {
+  ComponentDecl d;
+  d.type = "sink.metrics";
+  d.kind = ComponentKind::Sink;
+  d.summary = "Ensemble RMSE, bias, ANEES and ANIS with chi-square bands of one filter against truth";
+  d.doc =
+      "Inputs: one filter's estimates, truth, and optionally converted measurements (for a measurement-only "
+      "RMSE baseline and rmse_ratio), e.g. inputs: [kf, truth, cm]. Estimates are matched to truth at the same "
+      "time (within time_tolerance) or by linear interpolation between truth samples; estimates outside the "
+      "truth's time span are counted as unmatched_estimates. ANEES_k = sum over runs of NEES / (n M) per time "
+      "step (n = 6, or 3 for anees_position); anees is its mean over steps, with the per-step band "
+      "[chi2inv((1-c)/2, nM), chi2inv((1+c)/2, nM)]/(nM) (Bar-Shalom, Li & Kirubarajan 2001 §5.4.2). ANIS "
+      "likewise with the innovation dimension. Without truth (recorded logs) only anis, mean_innovation_<i> "
+      "and counts are reported. Only initialised estimates are scored.";
+  d.params = {
+      ParamSpec::real("skip_initial", dim::time, "leave out estimates earlier than the first initialised estimate + this (transient)")
+          .def("0 s")
+          .at_least(0),
+      ParamSpec::real("confidence", dim::none, "probability of the chi-square acceptance bands, in (0, 1)")
+          .def("0.95")
+          .positive()
+          .at_most(1),
+      ParamSpec::real("time_tolerance", dim::time, "items closer in time than this are the same time step")
+          .def("1 us")
+          .positive(),
+  };
+  d.accepts = ItemKind::Estimate | ItemKind::Truth | mask(ItemKind::Measurement);
+  d.min_inputs = 1;
+  d.max_inputs = -1;
+  d.produces = 0;
+  d.create = [](const Params& p) { return std::make_unique<MetricsSink>(p); };
+  r.add(std::move(d));
+}
+
+}  // namespace
+}  // namespace trackflow
+
+TRACKFLOW_PLUGIN("sink.metrics", trackflow::register_components)

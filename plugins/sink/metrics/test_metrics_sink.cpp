@@ -1,0 +1,339 @@
+// Purpose: tests of sink.metrics: RMSE/bias by hand, ANEES/ANIS of consistent and overconfident estimators, bands, matching, no-truth mode.
+#include <trackflow/geometry.hpp>
+#include <trackflow/rng.hpp>
+
+#include <Eigen/Dense>
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <functional>
+#include <string>
+
+#include "plugin_fixture.hpp"
+
+using namespace trackflow;
+
+namespace {
+
+const InputInfo kFilter{"kf", "filter.kalman", mask(ItemKind::Estimate)};
+const InputInfo kTruth{"truth", "sim.trajectory", mask(ItemKind::Truth)};
+const InputInfo kConverted{"cm", "convert.classical", mask(ItemKind::Measurement)};
+
+Truth truth(double t, Vec3 p, Vec3 v = Vec3::Zero()) {
+  Truth x;
+  x.time = t;
+  x.position = p;
+  x.velocity = v;
+  return x;
+}
+
+Estimate estimate(double t, const Vec6& enu, const Mat6& cov = Mat6::Identity()) {
+  Estimate e;
+  e.time = t;
+  e.initialised = true;
+  e.enu = enu;
+  e.enu_covariance = cov;
+  return e;
+}
+
+Vec6 state(double x, double y, double z, double vx = 0, double vy = 0, double vz = 0) {
+  Vec6 s;
+  s << x, y, z, vx, vy, vz;
+  return s;
+}
+
+// Runs `runs` Monte Carlo runs the way the engine does: a worker instance per "thread" feeds
+// end_run() results to a separate aggregating instance, in run order.
+Summary run_ensemble(const std::string& params, const std::vector<InputInfo>& inputs, int runs,
+                     const std::function<void(Component&, int run)>& feed) {
+  auto worker = test::make("sink.metrics", params, "score");
+  auto aggregate = test::make("sink.metrics", params, "score");
+  worker->set_inputs(inputs);
+  aggregate->set_inputs(inputs);
+  Diagnostics diag;
+  for (int r = 0; r < runs; ++r) {
+    worker->start_run({static_cast<std::uint64_t>(r), 7, &diag});
+    feed(*worker, r);
+    auto result = worker->end_run();
+    REQUIRE(result);
+    aggregate->merge(*result);
+  }
+  Summary s;
+  aggregate->finish(s, {"score", "", static_cast<std::uint64_t>(runs)});
+  for (const auto& m : s.metrics) {
+    INFO(m.name);
+    CHECK(std::isfinite(m.value));
+  }
+  return s;
+}
+
+double value(const Summary& s, const std::string& name) {
+  const Metric* m = s.find(name);
+  INFO("metric " << name);
+  REQUIRE(m);
+  return m->value;
+}
+
+bool has_note(const Summary& s, const std::string& part) {
+  for (const auto& n : s.notes)
+    if (n.find(part) != std::string::npos) return true;
+  return false;
+}
+
+// Random symmetric positive-definite covariance with std devs of a few metres and m/s.
+Mat6 random_covariance(Rng& rng) {
+  Mat6 A;
+  for (int i = 0; i < 6; ++i)
+    for (int j = 0; j < 6; ++j) A(i, j) = rng.normal();
+  return A * A.transpose() + Mat6::Identity() * 2.0;
+}
+
+// Chi-square quantile of k dof at the standard normal quantile z (Wilson & Hilferty 1931).
+double wilson_hilferty(double k, double z) {
+  const double a = 2.0 / (9.0 * k);
+  return k * std::pow(1.0 - a + z * std::sqrt(a), 3);
+}
+
+}  // namespace
+
+TEST_CASE("RMSE, bias and max per-step RMS match a hand computation over 3 steps and 2 runs") {
+  // Errors (position; velocity) per run and step, truth moving along x.
+  const Vec6 err[2][3] = {{state(1, 2, 0, 1, 0, 0), state(-1, 0, 2, 0, 0, 0), state(0, 0, 0, 0, 2, 0)},
+                          {state(3, 0, 0, 0, 0, -1), state(1, 2, 2, 0, 0, 0), state(0, -2, 0, 1, 1, 0)}};
+  auto s = run_ensemble("{}", {kFilter, kTruth}, 2, [&](Component& c, int r) {
+    for (int k = 0; k < 3; ++k) {
+      const Truth t = truth(k * 0.5, Vec3(100 + 10 * k, 5, 1), Vec3(20, 0, 0));
+      Vec6 x;
+      x << t.position, t.velocity;
+      c.on_estimate(estimate(t.time, x + err[r][k]), 0);  // estimate first: order within a step is free
+      c.on_truth(t, 1);
+    }
+  });
+  // Squared position errors: run 0: 5, 5, 0; run 1: 9, 9, 4. Six (step, run) pairs.
+  CHECK(value(s, "position_rmse") == Approx(std::sqrt((5 + 5 + 0 + 9 + 9 + 4) / 6.0)));
+  CHECK(value(s, "position_rmse_x") == Approx(std::sqrt((1 + 1 + 0 + 9 + 1 + 0) / 6.0)));
+  CHECK(value(s, "position_rmse_y") == Approx(std::sqrt((4 + 0 + 0 + 0 + 4 + 4) / 6.0)));
+  CHECK(value(s, "position_rmse_z") == Approx(std::sqrt((0 + 4 + 0 + 0 + 4 + 0) / 6.0)));
+  CHECK(value(s, "velocity_rmse") == Approx(std::sqrt((1 + 0 + 4 + 1 + 0 + 2) / 6.0)));
+  CHECK(value(s, "velocity_rmse_x") == Approx(std::sqrt(2 / 6.0)));
+  CHECK(value(s, "velocity_rmse_z") == Approx(std::sqrt(1 / 6.0)));
+  CHECK(value(s, "mean_error_x") == Approx((1 - 1 + 0 + 3 + 1 + 0) / 6.0));
+  CHECK(value(s, "mean_error_y") == Approx((2 + 0 + 0 + 0 + 2 - 2) / 6.0));
+  CHECK(value(s, "mean_error_z") == Approx((0 + 2 + 0 + 0 + 2 + 0) / 6.0));
+  // Per-step RMS: step 0 sqrt(14/2), step 1 sqrt(14/2), step 2 sqrt(4/2).
+  CHECK(value(s, "max_position_error_rms") == Approx(std::sqrt(7.0)));
+  CHECK(value(s, "runs") == 2);
+  CHECK(value(s, "steps") == 3);
+  CHECK(value(s, "estimates") == 6);
+  CHECK(value(s, "unmatched_estimates") == 0);
+  CHECK(s.find("position_rmse")->unit == "m");
+  CHECK(s.find("velocity_rmse")->unit == "m/s");
+  // With identity covariance NEES is the squared error norm: ANEES over steps by hand.
+  const double nees_step[3] = {(5 + 1) + (9 + 1), (5 + 0) + (9 + 0), (0 + 4) + (4 + 2)};
+  CHECK(value(s, "anees") == Approx((nees_step[0] + nees_step[1] + nees_step[2]) / (3 * 6 * 2.0)));
+  CHECK(value(s, "anees_position") == Approx((14 + 14 + 4) / (3 * 3 * 2.0)));
+}
+
+TEST_CASE("the ANEES band for n=6, M=100 is [0.890, 1.116] and for n=3 [0.846, 1.166]") {
+  auto s = run_ensemble("{}", {kFilter, kTruth}, 100, [](Component& c, int) {
+    c.on_truth(truth(0, Vec3::Zero()), 1);
+    c.on_estimate(estimate(0, state(1, 1, 1, 1, 1, 1)), 0);
+  });
+  const Metric* a = s.find("anees");
+  REQUIRE(a);
+  REQUIRE(a->has_band);
+  CHECK(a->confidence == 0.95);
+  CHECK(a->band_lo == Approx(0.890).margin(0.0005));
+  CHECK(a->band_hi == Approx(1.116).margin(0.0005));
+  const Metric* p = s.find("anees_position");
+  REQUIRE(p);
+  CHECK(p->band_lo == Approx(0.846).margin(0.0005));
+  CHECK(p->band_hi == Approx(1.166).margin(0.0005));
+  CHECK(a->value == Approx(1.0));  // unit error in every component, identity covariance
+}
+
+TEST_CASE("a consistent estimator's ANEES and ANIS lie inside their bands; an overconfident one's do not") {
+  constexpr int kRuns = 200, kSteps = 50;
+  Rng setup(42);
+  const Mat6 P = random_covariance(setup);
+  const Mat6 L = P.llt().matrixL();
+  Eigen::Matrix3d S;
+  S << 4, 1, 0, 1, 9, 2, 0, 2, 16;
+  const Eigen::Matrix3d Ls = S.llt().matrixL();
+
+  for (double shrink : {1.0, 4.0}) {
+    double nees_sum = 0.0;  // independent ANEES: inverse by full-pivot LU instead of the sink's Cholesky
+    const Mat6 reported = P / shrink;
+    const Mat6 reported_inverse = reported.fullPivLu().inverse();
+    auto s = run_ensemble("{ confidence: 0.95 }", {kFilter, kTruth}, kRuns, [&](Component& c, int r) {
+      Rng rng(1000 + r);
+      for (int k = 0; k < kSteps; ++k) {
+        const double t = 0.1 * k;
+        const Truth tr = truth(t, Vec3(1000 + 50 * t, -300, 20), Vec3(50, 0, 0));
+        c.on_truth(tr, 1);
+        Vec6 z, x;
+        for (int i = 0; i < 6; ++i) z(i) = rng.normal();
+        const Vec6 e = L * z;
+        x << tr.position, tr.velocity;
+        Estimate est = estimate(t, x + e, reported);
+        nees_sum += e.dot(reported_inverse * e);
+        Vec3 w(rng.normal(), rng.normal(), rng.normal());
+        const Vec3 nu = Ls * w;
+        est.updated = true;
+        est.innovation = nu;
+        est.nis = nu.dot((S / shrink).inverse() * nu);
+        c.on_estimate(est, 0);
+      }
+    });
+    const Metric* a = s.find("anees");
+    const Metric* n = s.find("anis");
+    REQUIRE(a);
+    REQUIRE(n);
+    CHECK(a->value == Approx(nees_sum / (6.0 * kRuns * kSteps)).epsilon(1e-9));
+    if (shrink == 1.0) {
+      CHECK(a->value >= a->band_lo);
+      CHECK(a->value <= a->band_hi);
+      CHECK(n->value >= n->band_lo);
+      CHECK(n->value <= n->band_hi);
+      // Each step is inside its 95 % band with probability 0.95: 50 steps, sd of the fraction 0.031.
+      CHECK(value(s, "anees_steps_in_band") >= 0.95 - 4 * std::sqrt(0.95 * 0.05 / kSteps));
+      const Metric* ap = s.find("anees_position");
+      CHECK(ap->value >= ap->band_lo);
+      CHECK(ap->value <= ap->band_hi);
+    } else {
+      CHECK(a->value > a->band_hi);
+      CHECK(a->value == Approx(4.0).epsilon(0.05));
+      CHECK(n->value > n->band_hi);
+      CHECK(value(s, "anees_steps_in_band") == 0.0);
+    }
+    // ANIS band: innovation dimension 3 and 200 runs, i.e. chi-square with 600 dof, checked
+    // against the Wilson-Hilferty approximation (accurate to ~1e-4 at this many dof).
+    CHECK(n->band_lo == Approx(wilson_hilferty(600, -1.959964) / 600).margin(1e-3));
+    CHECK(n->band_hi == Approx(wilson_hilferty(600, 1.959964) / 600).margin(1e-3));
+  }
+}
+
+TEST_CASE("estimates between truth samples are compared with linearly interpolated truth") {
+  auto s = run_ensemble("{}", {kFilter, kTruth}, 1, [](Component& c, int) {
+    c.on_truth(truth(0.0, Vec3(0, 0, 0), Vec3(1, 2, 3)), 1);
+    c.on_truth(truth(1.0, Vec3(10, 20, 30), Vec3(3, 4, 5)), 1);
+    // Truth at 0.25: position (2.5, 5, 7.5), velocity (1.5, 2.5, 3.5); error (3, 4, 0) and (0, 0, 2).
+    c.on_estimate(estimate(0.25, state(5.5, 9, 7.5, 1.5, 2.5, 5.5)), 0);
+    // Within the 1 us tolerance of the last sample: that sample, not an extrapolation.
+    c.on_estimate(estimate(1.0 + 0.4e-6, state(13, 24, 30, 3, 4, 3)), 0);
+  });
+  CHECK(value(s, "position_rmse") == Approx(5.0));
+  CHECK(value(s, "velocity_rmse") == Approx(2.0));
+  CHECK(value(s, "unmatched_estimates") == 0);
+  CHECK(value(s, "steps") == 2);
+}
+
+TEST_CASE("estimates outside the truth's time span are counted as unmatched, not scored") {
+  auto s = run_ensemble("{}", {kFilter, kTruth}, 2, [](Component& c, int) {
+    c.on_estimate(estimate(0.5, state(100, 100, 100)), 0);  // before the first truth sample
+    c.on_truth(truth(1.0, Vec3::Zero()), 1);
+    c.on_estimate(estimate(1.0, state(1, 0, 0)), 0);
+    c.on_truth(truth(2.0, Vec3::Zero()), 1);
+    c.on_estimate(estimate(2.0, state(1, 0, 0)), 0);
+    c.on_estimate(estimate(2.0 + 5e-6, state(100, 0, 0)), 0);  // after the last, beyond the tolerance
+  });
+  CHECK(value(s, "estimates") == 8);
+  CHECK(value(s, "unmatched_estimates") == 4);
+  CHECK(value(s, "position_rmse") == Approx(1.0));
+  CHECK(has_note(s, "outside the truth's time span"));
+}
+
+TEST_CASE("skip_initial leaves out the transient after the first initialised estimate") {
+  auto s = run_ensemble("{ skip_initial: 3 s }", {kFilter, kTruth}, 1, [](Component& c, int) {
+    Estimate early = estimate(0.0, state(1000, 0, 0));
+    early.initialised = false;  // not yet initialised: neither scored nor the start of the transient
+    c.on_estimate(early, 0);
+    for (int k = 0; k < 10; ++k) {
+      const double t = 1.0 + k;
+      c.on_truth(truth(t, Vec3::Zero()), 1);
+      c.on_estimate(estimate(t, state(k < 3 ? 50.0 : 2.0, 0, 0)), 0);  // t = 1, 2, 3 are the transient
+    }
+  });
+  CHECK(value(s, "estimates") == 7);
+  CHECK(value(s, "position_rmse") == Approx(2.0));
+  CHECK(has_note(s, "skip_initial"));
+}
+
+TEST_CASE("converted measurements give the measurement RMSE baseline and rmse_ratio") {
+  auto s = run_ensemble("{}", {kFilter, kTruth, kConverted}, 2, [](Component& c, int r) {
+    const Vec3 p(3000, 4000, 500);
+    c.on_truth(truth(0.0, p), 1);
+    c.on_estimate(estimate(0.0, state(3001, 4000, 500)), 0);  // error 1 m
+    Measurement m;
+    m.time = 0.0;
+    if (r == 0) {  // Cartesian, 4 m off in z
+      m.frame = Frame::Cartesian;
+      m.value.resize(3);
+      m.value << p.x(), p.y(), p.z() + 4;
+    } else {  // spherical from a sensor at (100, 200, 0), 2 m long in range
+      m.frame = Frame::Spherical;
+      m.azimuth = AzimuthConvention::NorthClockwise;
+      m.sensor_position = Vec3(100, 200, 0);
+      const Vec3 d = p - m.sensor_position;
+      m.value.resize(3);
+      m.value << d.norm() + 2.0, std::atan2(d.x(), d.y()), std::asin(d.z() / d.norm());
+    }
+    m.covariance = MeasCov::Identity(3, 3);
+    c.on_measurement(m, 2);
+    Measurement invalid = m;
+    invalid.valid = false;  // flagged data carry no position: ignored
+    c.on_measurement(invalid, 2);
+  });
+  const double meas_rmse = std::sqrt((16.0 + 4.0) / 2.0);
+  CHECK(value(s, "measurement_position_rmse") == Approx(meas_rmse));
+  CHECK(value(s, "rmse_ratio") == Approx(1.0 / meas_rmse));
+}
+
+TEST_CASE("without truth only innovation statistics are reported") {
+  auto s = run_ensemble("{}", {kFilter}, 3, [](Component& c, int r) {
+    for (int k = 0; k < 4; ++k) {
+      Estimate e = estimate(k, state(k, 0, 0));
+      e.updated = k != 2;  // a coasting step: no innovation
+      e.innovation.resize(e.updated ? 2 : 0);
+      if (e.updated) e.innovation << r + k, -1.0;
+      e.nis = e.updated ? 1.5 : 0.0;
+      c.on_estimate(e, 0);
+    }
+  });
+  CHECK(s.find("position_rmse") == nullptr);
+  CHECK(s.find("anees") == nullptr);
+  CHECK(s.find("unmatched_estimates") == nullptr);
+  CHECK(has_note(s, "no truth"));
+  const Metric* anis = s.find("anis");
+  REQUIRE(anis);
+  CHECK(anis->has_band);
+  CHECK(anis->value == Approx(1.5 / 2.0));
+  // Innovation 0 over runs r = 0..2 and updated steps k = 0, 1, 3: mean of r + k = 1 + 4/3.
+  CHECK(value(s, "mean_innovation_0") == Approx(1.0 + 4.0 / 3.0));
+  CHECK(value(s, "mean_innovation_1") == Approx(-1.0));
+  CHECK(s.find("mean_innovation_2") == nullptr);
+  CHECK(value(s, "estimates") == 12);
+}
+
+TEST_CASE("metrics with no data are skipped with a note, never NaN") {
+  auto s = run_ensemble("{}", {kFilter, kTruth}, 2, [](Component& c, int) {
+    c.on_truth(truth(0.0, Vec3::Zero()), 1);
+    Estimate e = estimate(0.0, state(1, 0, 0));
+    e.enu_covariance = Mat6::Zero();  // not positive definite: no NEES
+    c.on_estimate(e, 0);
+  });
+  CHECK(value(s, "position_rmse") == Approx(1.0));
+  CHECK(s.find("anees") == nullptr);
+  CHECK(s.find("anis") == nullptr);
+  CHECK(has_note(s, "positive"));
+  CHECK(has_note(s, "anis"));
+}
+
+TEST_CASE("more than one estimate input, or a confidence outside (0, 1), is a configuration error") {
+  auto sink = test::make("sink.metrics", "{}", "score");
+  const InputInfo other{"ekf", "filter.ekf", mask(ItemKind::Estimate)};
+  CHECK_THROWS_WITH(sink->set_inputs({kFilter, kTruth, other}), Catch::Contains("use one sink.metrics per filter"));
+  CHECK_NOTHROW(sink->set_inputs({kFilter, kTruth, kConverted}));
+  CHECK_THROWS_AS(test::make("sink.metrics", "{ confidence: 1 }"), ConfigError);
+  CHECK_THROWS_AS(test::make("sink.metrics", "{ confidence: 0 }"), ConfigError);
+}
