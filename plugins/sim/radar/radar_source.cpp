@@ -1,4 +1,8 @@
-// Purpose: sim.radar — measures Truth as spherical range/azimuth/elevation(/range rate) with constant bias and Gaussian noise.
+// Purpose: sim.radar — measures Truth as spherical range/azimuth/elevation(/range rate) with bias, modelled noise, shot bursts and mode/lock schedules.
+#include "noise_model.hpp"
+#include "shot_noise.hpp"
+#include "time_windows.hpp"
+
 #include <trackflow/geometry.hpp>
 #include <trackflow/plugin.hpp>
 #include <trackflow/rng.hpp>
@@ -9,14 +13,30 @@
 namespace trackflow {
 namespace {
 
-// Standard deviations of the white noise on each channel for one look.
-struct NoiseSigmas {
-  double range = 0.0, azimuth = 0.0, elevation = 0.0, range_rate = 0.0;
-};
+using sim::NoiseSigmas;
+
+MeasMode mode_of(const std::string& name) {
+  if (name == "beacon") return MeasMode::Beacon;
+  if (name == "skin") return MeasMode::Skin;
+  return MeasMode::Unknown;
+}
+
+// A shot_* parameter written while shot noise is off would be silently ignored.
+void check_shot_params(const Params& p, const sim::ShotNoise& shot) {
+  if (!shot.enabled) {
+    for (const char* name : {"shot_length", "shot_period", "shot_magnitude", "shot_offset"})
+      if (p.given(name)) throw p.error(name, "is set but shot_noise is false; add 'shot_noise: true'");
+    return;
+  }
+  if (shot.length > shot.period)
+    throw p.error("shot_length", "(" + std::to_string(shot.length) + ") must not exceed shot_period (" +
+                                     std::to_string(shot.period) + ")");
+}
 
 // z_m = h(x) + b + w (paper 001 eq 1-3: r_m = r + r_B + w_r, likewise az, el), w ~ N(0, diag σ²).
-// The reported covariance is diag σ²: what the radar adds at random; the biases are a systematic
-// error the downstream filter is not told about.
+// The reported covariance is diag σ² of the σ's this look used, except that a shot-noise
+// burst is not in it (the radar does not know); the biases are a systematic error the
+// downstream filter is not told about.
 class RadarSource final : public Component {
  public:
   explicit RadarSource(const Params& p)
@@ -25,9 +45,17 @@ class RadarSource final : public Component {
         bias_range_(p.real("bias_range")),
         bias_azimuth_(p.real("bias_azimuth")),
         bias_elevation_(p.real("bias_elevation")),
-        every_(p.integer("every")) {
-    base_sigmas_ = {p.real("sigma_range"), p.real("sigma_azimuth"), p.real("sigma_elevation"),
-                    p.real("sigma_range_rate")};
+        every_(p.integer("every")),
+        noise_(p),
+        modes_(p, "mode_schedule", true),
+        unlocked_(p, "invalid_schedule", false),
+        default_mode_(mode_of(p.text("default_mode"))) {
+    shot_.enabled = p.boolean("shot_noise");
+    shot_.length = p.integer("shot_length");
+    shot_.period = p.integer("shot_period");
+    shot_.offset = p.has("shot_offset") ? p.integer("shot_offset") : shot_.period;
+    shot_.magnitude = p.real("shot_magnitude");
+    check_shot_params(p, shot_);
     convention_ = p.text("azimuth_convention") == "north_clockwise" ? AzimuthConvention::NorthClockwise
                                                                      : AzimuthConvention::XCounterClockwise;
     const bool with_range_rate = p.boolean("range_rate");
@@ -44,6 +72,7 @@ class RadarSource final : public Component {
   void start_run(const RunContext& ctx) override {
     rng_.reseed(ctx.seed);
     received_ = 0;
+    emitted_ = 0;
     diagnostics_ = ctx.diagnostics;
   }
 
@@ -57,29 +86,46 @@ class RadarSource final : public Component {
     // enu_to_spherical returns 0 for it (atan2(0, 0)); range_rate returns |v| at zero range.
     const Vec3 d = t.position - sensor_position_;
     const Vec3 rae = enu_to_spherical(d, convention_);
-    const NoiseSigmas s = sigmas_for(rae);
+    const sim::TimeWindow* window = modes_.find(t.time);
+    const NoiseSigmas nominal = sigmas_for(rae, window);
     m_.time = t.time;
-    m_.mode = MeasMode::Unknown;
-    m_.valid = true;
+    m_.mode = window ? window->mode : default_mode_;
+    m_.valid = unlocked_.find(t.time) == nullptr;
     m_.value(0) = rae(0) + bias_range_;
     m_.value(1) = rae(1) + bias_azimuth_;
     m_.value(2) = rae(2) + bias_elevation_;
     if (m_.has_range_rate) m_.value(3) = range_rate(d, t.velocity);
-    add_noise(s);
+    add_noise(nominal.scaled(shot_.factor(emitted_)));
     m_.value(1) = wrap_angle(m_.value(1));
-    m_.covariance.diagonal()(0) = s.range * s.range;
-    m_.covariance.diagonal()(1) = s.azimuth * s.azimuth;
-    m_.covariance.diagonal()(2) = s.elevation * s.elevation;
-    if (m_.has_range_rate) m_.covariance.diagonal()(3) = s.range_rate * s.range_rate;
+    m_.covariance.diagonal()(0) = nominal.range * nominal.range;
+    m_.covariance.diagonal()(1) = nominal.azimuth * nominal.azimuth;
+    m_.covariance.diagonal()(2) = nominal.elevation * nominal.elevation;
+    if (m_.has_range_rate) m_.covariance.diagonal()(3) = nominal.range_rate * nominal.range_rate;
+    ++emitted_;
     out.emit(m_);
   }
 
  private:
-  // The σ's of this look. Constant now; SNR-dependent noise and noise-scale presets belong here.
-  NoiseSigmas sigmas_for(const Vec3& /*range_az_el*/) const { return base_sigmas_; }
+  // The σ's of this look as the radar knows them: the noise model's (which, for the snr model,
+  // draws the SNR jitter and sets the SNR), replaced channel by channel by the mode window's
+  // overrides, then multiplied by the noise scale.
+  NoiseSigmas sigmas_for(const Vec3& range_az_el, const sim::TimeWindow* window) {
+    const sim::Look look = noise_.look(range_az_el(0), rng_);
+    m_.has_snr = look.has_snr;
+    m_.snr_db = look.snr_db;
+    NoiseSigmas s = look.sigmas;
+    if (window) {
+      s.range = window->sigma_range.value_or(s.range);
+      s.azimuth = window->sigma_azimuth.value_or(s.azimuth);
+      s.elevation = window->sigma_elevation.value_or(s.elevation);
+      s.range_rate = window->sigma_range_rate.value_or(s.range_rate);
+    }
+    return s.scaled(noise_.scale());
+  }
 
-  // The only place that draws random numbers; the order (range, az, el, rdot) is part of the
-  // output's definition for a given seed. Shot noise would be added here.
+  // With sigmas_for, the only place that draws random numbers: the order (range, az, el, rdot)
+  // is part of the output's definition for a given seed. Whatever the σ's (bursts, windows,
+  // presets), the same standard normals are drawn, so those options never shift the sequence.
   void add_noise(const NoiseSigmas& s) {
     m_.value(0) += s.range * rng_.normal();
     m_.value(1) += s.azimuth * rng_.normal();
@@ -91,34 +137,129 @@ class RadarSource final : public Component {
   Vec3 sensor_position_;
   double bias_range_, bias_azimuth_, bias_elevation_;
   long long every_;
-  NoiseSigmas base_sigmas_;
+  sim::NoiseModel noise_;
+  sim::TimeWindows modes_;
+  sim::TimeWindows unlocked_;
+  MeasMode default_mode_;
+  sim::ShotNoise shot_;
   AzimuthConvention convention_;
   Rng rng_;
   long long received_ = 0;
+  long long emitted_ = 0;  // measurements of this run so far: the shot-noise sample index
   Diagnostics* diagnostics_ = nullptr;
   Measurement m_;
 };
+
+std::vector<ParamSpec> window_fields(bool with_mode) {
+  std::vector<ParamSpec> f = {
+      ParamSpec::real("start", dim::time, "first time in the window (inclusive)").req(),
+      ParamSpec::real("end", dim::time, "end of the window (exclusive), after start").req(),
+  };
+  if (!with_mode) return f;
+  f.push_back(ParamSpec::choice("mode", {"beacon", "skin"}, "tracking mode written into measurements in this window").req());
+  f.push_back(ParamSpec::real("sigma_range", dim::length, "range sigma in this window (default: the noise model's)").at_least(0));
+  f.push_back(ParamSpec::real("sigma_azimuth", dim::angle, "azimuth sigma in this window (default: the noise model's)").at_least(0));
+  f.push_back(ParamSpec::real("sigma_elevation", dim::angle, "elevation sigma in this window (default: the noise model's)").at_least(0));
+  f.push_back(ParamSpec::real("sigma_range_rate", dim::velocity, "range-rate sigma in this window (default: the noise model's)")
+                  .at_least(0));
+  return f;
+}
+
+const char* const kDoc =
+    "Measurement model (paper 001 eq 1-3): r_m = r + bias_range + w_r, az_m = wrap(az + bias_azimuth + w_az), "
+    "el_m = el + bias_elevation + w_el, rdot_m = rdot + w_rdot, w ~ N(0, sigma^2). Geometry is taken from the target "
+    "relative to `position` in the pipeline's ENU frame. Range is not clipped at zero, so near the radar a noisy range "
+    "can be negative; azimuth is 0 where it is undefined (at the radar, straight overhead); elevation is not folded.\n"
+    "Noise sigmas (noise_model): constant = sigma_range/azimuth/elevation. snr = paper 001 eq 6-8, "
+    "sigma_r = range_resolution / sqrt(2 SNR), sigma_az = beamwidth_azimuth / (monopulse_slope sqrt(2 SNR)), sigma_el "
+    "likewise with beamwidth_elevation, SNR linear; SNR(dB) = snr_reference - 10 n log10(R / snr_reference_range) + "
+    "snr_jitter N(0,1), n = 4 (snr_law radar_r4: skin echo, two-way radar equation) or n = 2 (beacon_r2: a "
+    "transponder, each leg of the link is one-way, as paper 001's radar beacon system; paper 001 uses 3 dB jitter). "
+    "R is taken as at least 1 m and SNR is held within [-200, 300] dB so sigma stays finite. table4 = paper 000 Table 4 "
+    "(S/N 45 dB: 0.3 m, 50 urad up to 158.48 km; 29 dB: 1.9 m, 320 urad at 1000 km; 25.47 dB: 3 m, 500 urad at "
+    "1500 km; 22.97 dB: 4.3 m, 630 urad at 2000 km): between rows sigma is a power law in range (log-log) and S/N "
+    "linear in log range, which is exact for the table's own R^-2 S/N; held at the first row below 158.48 km and at "
+    "the last beyond 2000 km. snr and table4 set the measurement's snr_db; sigma_range_rate is used in every model.\n"
+    "Noise scale: every sigma (all channels, all models, mode-window overrides included) is multiplied by "
+    "noise_factor x noise_preset (best 0.5, none/normal 1, worst 2; paper 000 Table 15); noise_factor 5 and 10 are "
+    "paper 001's SCN.2 and SCN.3. The factors scale sigma, not the reported SNR.\n"
+    "Shot noise (paper 000 Case 1, Table 15: a 10-sample burst of noise 10^6 times the reference noise, every 4000 "
+    "samples): in a burst every channel's sigma is multiplied by shot_magnitude. The paper gives the burst's \"size\" "
+    "in the same words as the 0.5x/1x/2x presets, which scale sigma, so the magnitude multiplies sigma, not the "
+    "variance. Samples are this radar's measurements in a run, counted from 0; bursts start at shot_offset "
+    "(default: one shot_period in, so the first samples are clean), shot_offset + shot_period, ... The reported "
+    "covariance keeps the nominal sigma: the radar does not know about the burst.\n"
+    "Schedules: mode_schedule windows [start, end) set the measurement's mode (beacon/skin) and may override sigmas "
+    "(replacing the noise model's, before the noise scale); outside them the mode is default_mode. Measurements inside "
+    "an invalid_schedule window have valid = false (radar not locked; filters coast) but still carry a finite noisy "
+    "value. Windows of one schedule must not overlap.\n"
+    "Random draws, per emitted measurement, from the run's seed: for noise_model snr one standard normal for the SNR "
+    "jitter (drawn even when snr_jitter is 0), then one each for range, azimuth, elevation and, if measured, range "
+    "rate. Bursts, schedules, presets and factors only change the sigma multiplying these draws, so they never shift "
+    "the sequence. Truth items skipped by `every` or for being non-finite draw nothing.";
 
 void register_components(Registrar& r) {
   ComponentDecl d;
   d.type = "sim.radar";
   d.kind = ComponentKind::Source;
-  d.summary = "Simulated radar: Truth -> spherical [range, azimuth, elevation(, range_rate)] with bias and Gaussian noise";
-  d.doc = "Measurement model (paper 001 eq 1-3): r_m = r + bias_range + w_r, az_m = wrap(az + bias_azimuth + w_az), "
-          "el_m = el + bias_elevation + w_el, rdot_m = rdot + w_rdot, with w ~ N(0, sigma^2) drawn in that order from "
-          "the run's seed. Geometry is taken from the target relative to `position` in the pipeline's ENU frame. The "
-          "reported covariance is diag(sigma^2): biases are not in it. Range is not clipped at zero, so near the "
-          "radar a noisy range can be negative; azimuth is 0 where it is undefined (at the radar, straight overhead).";
+  d.summary = "Simulated radar: Truth -> spherical [range, azimuth, elevation(, range_rate)] with bias and constant, "
+              "SNR or Table-4 noise, noise presets, shot bursts, beacon/skin and lock schedules";
+  d.doc = kDoc;
   d.params = {
       ParamSpec::real_list("position", dim::length, "radar position in the ENU frame [x east, y north, z up]", 3)
           .def("[0, 0, 0]"),
-      ParamSpec::real("sigma_range", dim::length, "range noise standard deviation").def("10 m").at_least(0),
-      ParamSpec::real("sigma_azimuth", dim::angle, "azimuth noise standard deviation").def("1 mrad").at_least(0),
-      ParamSpec::real("sigma_elevation", dim::angle, "elevation noise standard deviation").def("1 mrad").at_least(0),
+      ParamSpec::choice("noise_model", {"constant", "snr", "table4"},
+                        "where sigma comes from: the sigma_* values, the SNR link budget (paper 001 eq 6-8), or "
+                        "paper 000 Table 4 over range")
+          .def("constant"),
+      ParamSpec::real("sigma_range", dim::length, "constant model: range noise standard deviation").def("10 m").at_least(0),
+      ParamSpec::real("sigma_azimuth", dim::angle, "constant model: azimuth noise standard deviation").def("1 mrad").at_least(0),
+      ParamSpec::real("sigma_elevation", dim::angle, "constant model: elevation noise standard deviation")
+          .def("1 mrad")
+          .at_least(0),
       ParamSpec::boolean("range_rate", "also measure range rate (4th element of the value)").def("false"),
-      ParamSpec::real("sigma_range_rate", dim::velocity, "range-rate noise standard deviation (when range_rate)")
+      ParamSpec::real("sigma_range_rate", dim::velocity, "range-rate noise standard deviation (when range_rate; all models)")
           .def("1 m/s")
           .at_least(0),
+      ParamSpec::real("range_resolution", dim::length, "snr model: range resolution delta_r").def("15 m").positive(),
+      ParamSpec::real("beamwidth_azimuth", dim::angle, "snr model: azimuth beamwidth").def("2 deg").positive(),
+      ParamSpec::real("beamwidth_elevation", dim::angle, "snr model: elevation beamwidth").def("2 deg").positive(),
+      ParamSpec::real("monopulse_slope", dim::none, "snr model: monopulse sum/difference slope k_m").def("1.6").positive(),
+      ParamSpec::real("snr_reference", dim::decibel, "snr model: SNR at snr_reference_range")
+          .def("30 dB")
+          .at_least(-200)
+          .at_most(300),
+      ParamSpec::real("snr_reference_range", dim::length, "snr model: range of snr_reference").def("10 km").positive(),
+      ParamSpec::choice("snr_law", {"radar_r4", "beacon_r2"},
+                        "snr model: SNR falls as R^-4 (skin echo) or R^-2 (beacon/transponder, one-way legs)")
+          .def("radar_r4"),
+      ParamSpec::real("snr_jitter", dim::decibel, "snr model: standard deviation of the per-measurement SNR error (paper 001: 3 dB)")
+          .def("0 dB")
+          .at_least(0)
+          .at_most(30),
+      ParamSpec::real("noise_factor", dim::none, "multiplies every sigma (degraded operation: paper 001 SCN.2 x5, SCN.3 x10)")
+          .def("1")
+          .at_least(0)
+          .at_most(1e6),
+      ParamSpec::choice("noise_preset", {"none", "best", "normal", "worst"},
+                        "paper 000 noise scale: best 0.5x, normal 1x, worst 2x sigma, times noise_factor")
+          .def("none"),
+      ParamSpec::boolean("shot_noise", "add shot-noise bursts (paper 000 Case 1)").def("false"),
+      ParamSpec::integer("shot_length", "shot noise: samples per burst (paper: 10)").def("10").at_least(1),
+      ParamSpec::integer("shot_period", "shot noise: samples from one burst start to the next (paper: 4000)")
+          .def("4000")
+          .at_least(1),
+      ParamSpec::real("shot_magnitude", dim::none, "shot noise: sigma multiplier in a burst (paper: 10^6)")
+          .def("1e6")
+          .at_least(0)
+          .at_most(1e12),
+      ParamSpec::integer("shot_offset", "shot noise: sample index of the first burst (default: shot_period)").at_least(0),
+      ParamSpec::records("mode_schedule", window_fields(true),
+                         "windows {start, end, mode: beacon|skin, optional sigma_range/azimuth/elevation/range_rate}"),
+      ParamSpec::choice("default_mode", {"unknown", "beacon", "skin"}, "mode of measurements outside mode_schedule windows")
+          .def("unknown"),
+      ParamSpec::records("invalid_schedule", window_fields(false),
+                         "windows {start, end} in which measurements are flagged valid = false (radar not locked)"),
       ParamSpec::real("bias_range", dim::length, "constant range bias added to every measurement").def("0 m"),
       ParamSpec::real("bias_azimuth", dim::angle, "constant azimuth bias").def("0 rad"),
       ParamSpec::real("bias_elevation", dim::angle, "constant elevation bias").def("0 rad"),

@@ -1,5 +1,7 @@
-// Purpose: validation of trajectory segment records and exact propagation of CV, CA and coordinated-turn pieces.
+// Purpose: validation of trajectory segment records and exact propagation of CV, CA, coordinated-turn and launch pieces.
 #include "flight_plan.hpp"
+
+#include "launch_profile.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -113,11 +115,20 @@ Kinematics evaluate(const MotionPiece& p, double t) {
       k.acceleration = Vec3(-w * k.velocity.y(), w * k.velocity.x(), 0.0);  // w z^ x v: centripetal
       return k;
     }
+    case Motion::Launch:
+      return p.launch->at(dt);
   }
   return {p.position, p.velocity, Vec3::Zero()};
 }
 
 std::vector<MotionPiece> build_flight_plan(const Params& params) {
+  // Worded and located as the validator words a missing required parameter (the declaration
+  // cannot mark them required: a launch profile replaces them).
+  for (const char* name : {"initial_position", "segments"})
+    if (!params.has(name))
+      throw ConfigError(std::string("missing required parameter '") + name + "' (needed unless 'profile' is set)",
+                        params.where(), params.node());
+  refuse_launch_params(params);
   const auto& segments = params.records("segments");
   if (segments.empty()) throw params.error("segments", "needs at least one segment");
   std::vector<MotionPiece> pieces;

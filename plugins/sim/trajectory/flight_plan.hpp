@@ -1,14 +1,17 @@
-// Purpose: a trajectory as analytic motion pieces (CV, CA, horizontal turn) built from validated segment records.
+// Purpose: a trajectory as analytic motion pieces (CV, CA, horizontal turn, launch profile) built from validated segment records.
 #pragma once
 
 #include <trackflow/items.hpp>
 #include <trackflow/params.hpp>
 
+#include <memory>
 #include <vector>
 
 namespace trackflow::sim {
 
-enum class Motion { ConstantVelocity, ConstantAcceleration, Turn };
+class LaunchPath;
+
+enum class Motion { ConstantVelocity, ConstantAcceleration, Turn, Launch };
 
 // One interval of closed-form motion. Velocity changes are not pieces: they are folded into
 // the initial velocity of the piece that follows them.
@@ -19,6 +22,7 @@ struct MotionPiece {
   Vec3 velocity = Vec3::Zero();
   Vec3 acceleration = Vec3::Zero();  // ConstantAcceleration only
   double turn_rate = 0.0;            // Turn only, rad/s, positive counter-clockwise seen from above
+  std::shared_ptr<const LaunchPath> launch;  // Launch only: the path, its time 0 at `start`
 };
 
 struct Kinematics {
@@ -31,6 +35,8 @@ Kinematics evaluate(const MotionPiece& piece, double t);
 // Validates the `segments` records of `params` (fields that do not belong to a segment's type,
 // missing fields, undefined heading/climb) and chains them from the initial state.
 // Never empty: a trailing velocity change gets a zero-length piece so it shows in the output.
+// `initial_position` and `segments` are required here (the declaration leaves them optional
+// because a launch profile replaces them).
 std::vector<MotionPiece> build_flight_plan(const Params& params);
 
 }  // namespace trackflow::sim

@@ -181,6 +181,30 @@ TEST_CASE("a straight constant-speed descent (landing approach)") {
   for (const Truth& t : truths) CHECK(t.velocity.norm() == Approx(60));
 }
 
+TEST_CASE("landing approach (paper 001): straight constant-speed descent along the runway to a radar at touchdown") {
+  // Runway along +x (heading 090), radar at the touchdown point (the origin); 3 deg glide slope from
+  // 5 km out at 60 m/s. Existing segments express it: a velocity_change, then constant velocity until
+  // the track reaches the radar.
+  const double glide = 3 * std::numbers::pi / 180, speed = 60, out = 5000;
+  const double height = out * std::tan(glide), duration = out / (speed * std::cos(glide));
+  const auto truths = fly("rate: 10 Hz\ninitial_position: [" + num(-out) + ", 0, " + num(height) + "]\n"
+                          "segments:\n  - {type: velocity_change, speed: 60 m/s, heading: 90 deg, climb: -3 deg}\n"
+                          "  - {type: constant_velocity, duration: " + num(duration) + " s}\n");
+  REQUIRE(truths.size() == static_cast<size_t>(std::floor(duration * 10)) + 1);
+  const double start_range = out / std::cos(glide);
+  for (const Truth& t : truths) {
+    if (t.time == truths.back().time) break;
+    const Vec3& p = t.position;
+    INFO("t = " << t.time);
+    CHECK(std::abs(p.y()) < 1e-9);                                             // on the centreline
+    CHECK(std::atan2(p.z(), -p.x()) == Approx(glide).epsilon(1e-12));          // constant elevation seen from the radar
+    CHECK(p.norm() == Approx(start_range - speed * t.time).margin(1e-8));       // range closes at the airspeed
+    CHECK(t.velocity.dot(p) / p.norm() == Approx(-speed).epsilon(1e-12));      // range rate -60 m/s
+  }
+  // The last sample (at most one period before touchdown) is within one period's travel of the radar.
+  CHECK(truths.back().position.norm() < speed * 0.1 + 1e-9);
+}
+
 TEST_CASE("sample times are start_time + k / rate up to the end, inclusive") {
   SECTION("10 Hz from 2 s over 3 s") {
     const auto truths = fly("rate: 10 Hz\nstart_time: 2 s\ninitial_position: [0, 0, 0]\n"

@@ -1,5 +1,6 @@
-// Purpose: sim.trajectory — a truth generator that flies a list of CV / CA / turn / velocity-change segments exactly.
+// Purpose: sim.trajectory — a truth generator that flies CV / CA / turn / velocity-change segments or a launch profile exactly.
 #include "flight_plan.hpp"
+#include "launch_profile.hpp"
 
 #include <trackflow/plugin.hpp>
 
@@ -19,7 +20,7 @@ constexpr double kTimeTolerance = 1e-9;  // s
 class TrajectorySource final : public Generator {
  public:
   explicit TrajectorySource(const Params& params)
-      : pieces_(sim::build_flight_plan(params)),
+      : pieces_(params.text("profile") == "none" ? sim::build_flight_plan(params) : sim::build_launch_plan(params)),
         rate_(params.real("rate")),
         start_(params.real("start_time")) {
     truth_.target = static_cast<std::uint32_t>(params.integer("target"));
@@ -84,20 +85,44 @@ void register_components(Registrar& r) {
   ComponentDecl d;
   d.type = "sim.trajectory";
   d.kind = ComponentKind::Source;
-  d.summary = "Simulated target truth (ENU) flying constant-velocity, constant-acceleration, turn and velocity-change segments";
+  d.summary = "Simulated target truth (ENU) flying constant-velocity, constant-acceleration, turn and velocity-change "
+              "segments, or the KSLV-I launch profile";
   d.doc = "Each segment is propagated in closed form from where the previous one ended (no numerical integration). "
           "A turn is a horizontal coordinated turn at constant rate that keeps the vertical velocity. A "
           "velocity_change is instantaneous: a sample at its time already shows the new velocity. Truth "
           "(position, velocity, acceleration) is emitted at start_time + k/rate up to and including the end of the "
           "last segment. Example (paper 002, circle R = 1500 m at 200 m/s): initial_position: [0, 0, 150 m], "
-          "initial_velocity: [200 m/s, 0, 0], segments: [{type: turn, turn_rate: 0.13333 rad/s, duration: 47.124 s}].";
+          "initial_velocity: [200 m/s, 0, 0], segments: [{type: turn, turn_rate: 0.13333 rad/s, duration: 47.124 s}]. "
+          "A landing approach is a velocity_change (speed, heading along the runway, climb = -glide slope) and a "
+          "constant_velocity segment aimed at the touchdown point.\n"
+          "profile: kslv1 replaces the segments by the KSLV-I ascent of paper 000 Table 16 (time s / altitude km / "
+          "downrange km: 0/0.1/0, 0.2/0.1/0, 54/7.2/0.8, 215/177/245, 229/193/303, 232/196/316, 395/303/1052, "
+          "453/304/1390, 540/302/2054; paper 003 Table 2 prints the same numbers with the altitude and downrange "
+          "labels swapped), lift-off at start_time. Altitude and downrange are each a C2 cubic spline in time, clamped "
+          "to zero velocity at lift-off and natural (zero acceleration) at burn-out, so velocity and acceleration are "
+          "continuous and exact derivatives of the position; it passes through every row, peaks at about 305 km "
+          "between the 303 and 304 km rows, reaches about 8.1 km/s at 540 s, and drifts up to about 250 m uprange "
+          "(downrange < 0) near 28 s, an artefact of the 0.8 km row at 54 s next to 245 km at 215 s. The track starts "
+          "at pad_position (ENU, relative to the frame's origin, e.g. a radar ~100 km away) and runs along the "
+          "compass launch_azimuth. earth: flat (default) lays downrange along a straight ground line and altitude "
+          "straight up from the pad's height, as paper 000's synthetic trajectory does (its Fig 48 ends ~300 km up); "
+          "it ignores the earth's curvature, which at 2054 km downrange puts the real vehicle about 340 km lower "
+          "(below a pad radar's horizon). earth: spherical bends the track over a sphere of radius 6371 km whose "
+          "surface passes through the frame's origin: downrange is the great-circle arc, altitude is measured from "
+          "the pad's radius, and the azimuth is the frame's compass direction carried to the pad.";
   d.params = {
       ParamSpec::real("rate", dim::frequency, "sample rate of the truth").def("10 Hz").positive(),
       ParamSpec::real("start_time", dim::time, "time of the first sample and of the start of the first segment").def("0 s"),
-      ParamSpec::real_list("initial_position", dim::length, "ENU position at start_time [x east, y north, z up]", 3).req(),
-      ParamSpec::real_list("initial_velocity", dim::velocity, "ENU velocity at start_time", 3).def("[0, 0, 0]"),
+      ParamSpec::real_list("initial_position", dim::length,
+                           "ENU position at start_time [x east, y north, z up] (required without a profile)", 3),
+      ParamSpec::real_list("initial_velocity", dim::velocity, "ENU velocity at start_time (segments only)", 3).def("[0, 0, 0]"),
       ParamSpec::integer("target", "target id written into each Truth item").def("0").at_least(0).at_most(4294967295.0),
-      ParamSpec::records("segments", segment_fields(), "the flight, in order (at least one)").req(),
+      ParamSpec::records("segments", segment_fields(), "the flight, in order (at least one; required without a profile)"),
+      ParamSpec::choice("profile", {"none", "kslv1"}, "fly a tabulated launch profile instead of segments").def("none"),
+      ParamSpec::real_list("pad_position", dim::length, "profile: launch pad position in the ENU frame", 3),
+      ParamSpec::real("launch_azimuth", dim::angle, "profile: compass direction of the downrange track, from north clockwise"),
+      ParamSpec::choice("earth", {"flat", "spherical"}, "profile: flat ground line (paper 000) or a spherical earth").def("flat"),
+      ParamSpec::real("profile_duration", dim::time, "profile: fly only the first part of it (default: the whole table)").positive(),
   };
   d.accepts = 0;
   d.min_inputs = 0;

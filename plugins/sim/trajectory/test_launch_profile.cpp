@@ -1,0 +1,228 @@
+// Purpose: tests of the cubic spline and the KSLV-I launch profile: table points, C² continuity, physical sanity, placement, sampling.
+#include "cubic_spline.hpp"
+#include "launch_profile.hpp"
+
+#include <Eigen/Geometry>
+#include <catch2/catch.hpp>
+
+#include "plugin_fixture.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <numbers>
+#include <string>
+
+using namespace trackflow;
+
+namespace {
+
+constexpr double kDeg = std::numbers::pi / 180;
+
+// Paper 000 Table 16, typed from the paper: time s, altitude km, downrange km.
+const double kTable16[][3] = {{0, 0.1, 0},     {0.2, 0.1, 0},   {54, 7.2, 0.8},     {215, 177, 245},    {229, 193, 303},
+                              {232, 196, 316}, {395, 303, 1052}, {453, 304, 1390}, {540, 302, 2054}};
+
+std::vector<Truth> fly(const std::string& yaml) {
+  auto gen = test::make("sim.trajectory", yaml);
+  test::Collector out;
+  out.attach_to(*gen);
+  test::drain(*gen);
+  return out.truths;
+}
+
+std::string config_error(const std::string& yaml) {
+  try {
+    (void)test::make("sim.trajectory", yaml);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return {};
+}
+
+sim::LaunchPath path(const Vec3& pad, double azimuth_deg, bool spherical) {
+  return sim::LaunchPath(sim::kslv1_table(), {pad, azimuth_deg * kDeg, spherical});
+}
+
+}  // namespace
+
+TEST_CASE("cubic spline: reproduces a cubic that meets its end conditions, and is C2 at the knots") {
+  // p(x) = 2 - x + 0.5 x^2 - 0.1 x^3 has p''(x) = 1 - 0.6 x, zero at x = 5/3: natural there.
+  auto p = [](double x) { return 2 - x + 0.5 * x * x - 0.1 * x * x * x; };
+  auto dp = [](double x) { return -1 + x - 0.3 * x * x; };
+  auto ddp = [](double x) { return 1 - 0.6 * x; };
+  const std::vector<double> x = {-1.0, -0.7, 0.0, 0.2, 1.1, 5.0 / 3.0};
+  std::vector<double> y;
+  for (double v : x) y.push_back(p(v));
+  const sim::CubicSpline s(x, y, sim::SplineEnd::clamped_to(dp(-1.0)), sim::SplineEnd::natural());
+  for (double t = -1.0; t <= 5.0 / 3.0; t += 0.01) {
+    const auto q = s.at(t);
+    CHECK(q.value == Approx(p(t)).margin(1e-12));
+    CHECK(q.first == Approx(dp(t)).margin(1e-11));
+    CHECK(q.second == Approx(ddp(t)).margin(1e-10));
+  }
+  // Both ends clamped also reproduces it.
+  const sim::CubicSpline c(x, y, sim::SplineEnd::clamped_to(dp(-1.0)), sim::SplineEnd::clamped_to(dp(5.0 / 3.0)));
+  CHECK(c.at(0.5).value == Approx(p(0.5)).margin(1e-12));
+  // Generic data: continuity of value, slope and curvature across each interior knot.
+  const sim::CubicSpline g({0, 1, 1.5, 4, 4.2, 9}, {0, 3, -1, 2, 2, 10}, sim::SplineEnd::natural(), sim::SplineEnd::natural());
+  for (double k : {1.0, 1.5, 4.0, 4.2}) {
+    const auto lo = g.at(k - 1e-9), hi = g.at(k + 1e-9);
+    CHECK(std::abs(lo.value - hi.value) < 1e-7);
+    CHECK(std::abs(lo.first - hi.first) < 1e-6);
+    CHECK(std::abs(lo.second - hi.second) < 1e-6);
+  }
+  CHECK(g.at(0).second == Approx(0).margin(1e-12));
+  CHECK(g.at(9).second == Approx(0).margin(1e-12));
+  CHECK_THROWS_AS(sim::CubicSpline({0, 1, 1}, {0, 1, 2}, {}, {}), std::invalid_argument);
+}
+
+TEST_CASE("KSLV-I profile passes through every row of paper 000 Table 16") {
+  // 5 Hz puts a sample on every table time; pad at the origin, launched due east (flat earth).
+  const auto truths = fly("rate: 5 Hz\nprofile: kslv1\npad_position: [0, 0, 0]\nlaunch_azimuth: 90 deg");
+  REQUIRE(truths.size() == 540 * 5 + 1);
+  for (const auto& row : kTable16) {
+    INFO("t = " << row[0]);
+    const Truth& t = truths.at(static_cast<size_t>(std::lround(row[0] * 5)));
+    REQUIRE(t.time == row[0]);
+    CHECK(t.position.x() == Approx(row[2] * 1e3).margin(1e-6));
+    CHECK(t.position.y() == Approx(0).margin(1e-6));
+    CHECK(t.position.z() == Approx((row[1] - 0.1) * 1e3).margin(1e-6));
+  }
+  // At rest at lift-off.
+  CHECK(truths[0].velocity.norm() < 1e-12);
+}
+
+TEST_CASE("KSLV-I velocity and acceleration are continuous and are the derivatives of the position") {
+  for (bool spherical : {false, true}) {
+    INFO((spherical ? "spherical" : "flat"));
+    const auto lp = path(Vec3(-60e3, 80e3, 30), 160, spherical);
+    // Across each interior knot: a jump of velocity or acceleration would show at once (a C1
+    // interpolant jumps by m/s^2 in acceleration here); over 2e-7 s the jerk moves them by < 1e-5.
+    for (int i = 1; i < 8; ++i) {
+      const double k = kTable16[i][0];
+      INFO("knot " << k);
+      const auto lo = lp.at(k - 1e-7), hi = lp.at(k + 1e-7);
+      CHECK((lo.velocity - hi.velocity).norm() < 1e-4);
+      CHECK((lo.acceleration - hi.acceleration).norm() < 1e-4);
+    }
+    // Central differences of position and velocity anywhere, knots included, match the reported
+    // velocity and acceleration. Straddling a knot, where the jerk jumps (by ~10 m/s^3 around the
+    // 3 s stage-separation interval), the velocity difference errs by jump * h / 4 = 2.5e-4 m/s^2
+    // at h = 1e-4 s; rounding adds ~1e-5 m/s.
+    const double h = 1e-4;
+    for (double t = 0.5; t < 539.5; t += 0.37) {
+      for (double tt : {t, std::floor(t)}) {
+        INFO("t = " << tt);
+        const auto k = lp.at(tt), a = lp.at(tt - h), b = lp.at(tt + h);
+        CHECK(((b.position - a.position) / (2 * h) - k.velocity).norm() < 1e-3);
+        CHECK(((b.velocity - a.velocity) / (2 * h) - k.acceleration).norm() < 1e-3);
+      }
+    }
+  }
+}
+
+TEST_CASE("KSLV-I profile is physically sensible") {
+  const auto truths = fly("rate: 10 Hz\nprofile: kslv1\npad_position: [0, 0, 0]\nlaunch_azimuth: 0 deg");
+  double max_speed = 0.0, time_of_max = 0.0, max_altitude = 0.0, min_altitude = 1e9, min_downrange = 0.0, max_accel = 0.0;
+  for (const Truth& t : truths) {
+    const double speed = t.velocity.norm();
+    if (speed > max_speed) max_speed = speed, time_of_max = t.time;
+    max_altitude = std::max(max_altitude, t.position.z());
+    min_altitude = std::min(min_altitude, t.position.z());
+    min_downrange = std::min(min_downrange, t.position.y());
+    max_accel = std::max(max_accel, t.acceleration.norm());
+  }
+  // Orbit insertion (paper 000: ~302 km, 2054 km downrange at 540 s) at 7-8.5 km/s, at the end.
+  CHECK(max_speed > 7000);
+  CHECK(max_speed < 8500);
+  CHECK(time_of_max > 500);
+  CHECK(truths.back().velocity.norm() == Approx(max_speed));
+  // Never below the pad; apogee between the 303 and 304 km rows, not far above them.
+  CHECK(min_altitude > -1e-3);
+  CHECK(max_altitude < 306e3 - 100);
+  // The documented uprange drift of the interpolant stays small, and only during the vertical rise.
+  CHECK(min_downrange > -300);
+  for (const Truth& t : truths)
+    if (t.time > 54) CHECK(t.position.y() > 0);
+  CHECK(max_accel < 5 * 9.81);
+  // Mach 1 (about 300 m/s) is passed near 54 s, as the table says.
+  const double v54 = truths[540].velocity.norm();
+  CHECK(v54 > 250);
+  CHECK(v54 < 500);
+}
+
+TEST_CASE("the launch track starts at the pad and runs along the launch azimuth") {
+  const auto truths = fly("rate: 1 Hz\nprofile: kslv1\npad_position: [100 km, -20 km, 5 m]\nlaunch_azimuth: 170 deg");
+  const Vec3 pad(100e3, -20e3, 5), track(std::sin(170 * kDeg), std::cos(170 * kDeg), 0);
+  CHECK((truths[0].position - pad).norm() < 1e-9);
+  for (const Truth& t : truths) {
+    const Vec3 d = t.position - pad;
+    CHECK(std::abs(d.x() * track.y() - d.y() * track.x()) < 1e-6);  // no cross-track component
+    CHECK(d.dot(track) > -300);
+    CHECK(std::abs(t.velocity.x() * track.y() - t.velocity.y() * track.x()) < 1e-9);
+  }
+  CHECK((truths.back().position - (pad + 2054e3 * track + Vec3(0, 0, 301.9e3))).norm() < 1e-6);
+}
+
+TEST_CASE("spherical earth: altitude above the sphere and great-circle downrange are kept") {
+  const Vec3 pad(-100e3, 30e3, 40);  // e.g. a pad 100 km west of the radar at the origin
+  const auto flat = path(pad, 100, false), round = path(pad, 100, true);
+  const Vec3 centre(0, 0, -sim::kEarthRadius);
+  const Vec3 up = (pad - centre).normalized();
+  const double pad_radius = (pad - centre).norm();
+  for (const auto& row : kTable16) {
+    INFO("t = " << row[0]);
+    const Vec3 p = round.at(row[0]).position - centre;
+    CHECK(p.norm() - pad_radius == Approx((row[1] - 0.1) * 1e3).margin(1e-6));
+    const double arc = std::atan2(p.cross(up).norm(), p.dot(up)) * sim::kEarthRadius;
+    CHECK(arc == Approx(row[2] * 1e3).margin(1e-6));
+  }
+  // The vehicle ends below the pad's horizon.
+  CHECK((round.at(540).position - pad).dot(up) < 0);
+  // Against the flat track from a pad at the origin (same local vertical): early on the curvature
+  // hardly matters (0.9 m: 7.1 km of altitude over 0.8 km of arc), at orbit insertion the vehicle is
+  // (R + h) cos(d / R) - R below the tangent plane instead of h above it.
+  const auto flat0 = path(Vec3::Zero(), 100, false), round0 = path(Vec3::Zero(), 100, true);
+  CHECK((round0.at(54).position - flat0.at(54).position).norm() < 1.5);
+  const double R = sim::kEarthRadius, h = 301.9e3, d = 2054e3;
+  CHECK(flat0.at(540).position.z() - round0.at(540).position.z() == Approx(h - ((R + h) * std::cos(d / R) - R)).margin(1e-3));
+  CHECK(std::hypot(round0.at(540).position.x(), round0.at(540).position.y()) == Approx((R + h) * std::sin(d / R)).margin(1e-3));
+}
+
+TEST_CASE("launch sampling: start_time shifts lift-off, rate sets the samples, profile_duration cuts") {
+  const auto truths = fly("rate: 40 Hz\nstart_time: 10 s\nprofile: kslv1\npad_position: [0, 0, 0]\n"
+                          "launch_azimuth: 45 deg\nprofile_duration: 200 s");
+  REQUIRE(truths.size() == 200 * 40 + 1);
+  for (size_t k = 0; k < truths.size(); ++k) CHECK(truths[k].time == 10.0 + static_cast<double>(k) / 40.0);
+  CHECK(truths.back().time == 210.0);
+  const Truth& mach1 = truths[54 * 40];  // 54 s after lift-off
+  CHECK(mach1.position.z() == Approx(7.1e3).margin(1e-6));
+  CHECK(std::hypot(mach1.position.x(), mach1.position.y()) == Approx(800).margin(1e-6));
+  CHECK(fly("rate: 40 Hz\nprofile: kslv1\npad_position: [0, 0, 0]\nlaunch_azimuth: 0 deg").size() == 540 * 40 + 1);
+}
+
+TEST_CASE("launch-profile parameters are checked against the mode") {
+  const std::string launch = "profile: kslv1\npad_position: [0, 0, 0]\nlaunch_azimuth: 90 deg\n";
+  struct Case {
+    std::string yaml;
+    const char* name;
+  };
+  const Case cases[] = {
+      {launch + "segments: [{type: constant_velocity, duration: 1 s}]", "segments"},
+      {launch + "initial_position: [0, 0, 0]", "initial_position"},
+      {launch + "initial_velocity: [1, 0, 0]", "initial_velocity"},
+      {"profile: kslv1\nlaunch_azimuth: 90 deg", "pad_position"},
+      {"profile: kslv1\npad_position: [0, 0, 0]", "launch_azimuth"},
+      {launch + "profile_duration: 541 s", "profile_duration"},
+      {launch + "earth: round", "earth"},
+      {"initial_position: [0, 0, 0]\nsegments: [{type: constant_velocity, duration: 1 s}]\npad_position: [0, 0, 0]",
+       "pad_position"},
+      {"initial_position: [0, 0, 0]\nsegments: [{type: constant_velocity, duration: 1 s}]\nearth: spherical", "earth"},
+      {"profile: falcon9\npad_position: [0, 0, 0]\nlaunch_azimuth: 0", "profile"},
+  };
+  for (const auto& c : cases) {
+    INFO(c.yaml);
+    CHECK_THAT(config_error(c.yaml), Catch::Matchers::Contains(std::string("'") + c.name + "'"));
+  }
+  CHECK(config_error(launch + "earth: spherical\nprofile_duration: 540 s").empty());
+}
