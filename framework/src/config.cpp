@@ -142,12 +142,23 @@ ExpectConfig parse_expect(const std::string& key, const SourceLoc& key_loc, cons
   e.metric = key.substr(dot + 1);
   if (v.kind != Value::Kind::Map || v.entries.empty())
     throw ConfigError("expect '" + key + "' must be a map such as { max: 25 } or { within_band: 0.95 }", v.loc);
-  static const std::vector<std::string> ops = {"min", "max", "within_band", "equals", "tolerance"};
+  static const std::vector<std::string> ops = {"min",    "max",       "within_band", "outside_band",
+                                               "equals", "tolerance", "less_than",   "greater_than"};
   reject_unknown_keys(v, ops, "expect '" + key + "'");
   // One check per entry would need a list; the usual {min, max} pair is split by the caller.
   for (size_t i = 0; i < v.entries.size(); ++i) {
     const auto& [op, val] = v.entries[i];
     if (op == "tolerance") continue;
+    if (op == "less_than" || op == "greater_than") {
+      const std::string ref = scalar(val, op);
+      const auto d = ref.find('.');
+      if (d == std::string::npos || d == 0 || d + 1 == ref.size())
+        throw ConfigError("expect '" + key + "': '" + op + "' needs <node id>.<metric>, got '" + ref + "'", val.loc);
+      e.op = op;
+      e.ref_node = ref.substr(0, d);
+      e.ref_metric = ref.substr(d + 1);
+      continue;
+    }
     try {
       e.op = op;
       e.value = std::stod(scalar(val, op));

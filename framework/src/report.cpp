@@ -54,25 +54,35 @@ std::string json_number(double v) {
   return buf;
 }
 
+namespace {
+
+const Metric& find_metric(const Outcome& out, const std::string& node, const std::string& metric, const SourceLoc& loc) {
+  const NodeOutcome* n = out.find(node);
+  if (!n) {
+    std::vector<std::string> ids;
+    for (const auto& x : out.nodes) ids.push_back(x.id);
+    throw ConfigError("expect names node '" + node + "', which does not exist" + did_you_mean(node, ids), loc);
+  }
+  const Metric* m = n->summary.find(metric);
+  if (!m) {
+    std::vector<std::string> names;
+    for (const auto& x : n->summary.metrics) names.push_back(x.name);
+    throw ConfigError("expect: node '" + node + "' has no metric '" + metric + "'" + did_you_mean(metric, names) +
+                          "; it reports: " + (names.empty() ? "none" : join(names)),
+                      loc);
+  }
+  return *m;
+}
+
+}  // namespace
+
 std::vector<ExpectResult> check_expects(const Graph& g, const Outcome& out) {
   std::vector<ExpectResult> results;
   for (const auto& e : g.config.expects) {
-    const NodeOutcome* n = out.find(e.node);
-    if (!n) {
-      std::vector<std::string> ids;
-      for (const auto& x : out.nodes) ids.push_back(x.id);
-      throw ConfigError("expect names node '" + e.node + "', which does not exist" + did_you_mean(e.node, ids), e.loc);
-    }
-    const Metric* m = n->summary.find(e.metric);
-    if (!m) {
-      std::vector<std::string> names;
-      for (const auto& x : n->summary.metrics) names.push_back(x.name);
-      throw ConfigError("expect: node '" + e.node + "' has no metric '" + e.metric + "'" +
-                            did_you_mean(e.metric, names) + "; it reports: " + (names.empty() ? "none" : join(names)),
-                        e.loc);
-    }
+    const Metric* m = &find_metric(out, e.node, e.metric, e.loc);
     ExpectResult r{e, false, m->value, {}};
     const std::string name = e.node + "." + e.metric + " = " + fmt(m->value);
+    bool comparable = std::isfinite(m->value);
     if (e.op == "max") {
       r.passed = m->value <= e.value;
       r.text = name + " <= " + fmt(e.value);
@@ -82,19 +92,27 @@ std::vector<ExpectResult> check_expects(const Graph& g, const Outcome& out) {
     } else if (e.op == "equals") {
       r.passed = std::fabs(m->value - e.value) <= e.tolerance;
       r.text = name + " == " + fmt(e.value) + " ± " + fmt(e.tolerance);
-    } else if (e.op == "within_band") {
+    } else if (e.op == "less_than" || e.op == "greater_than") {
+      const Metric& ref = find_metric(out, e.ref_node, e.ref_metric, e.loc);
+      const bool less = e.op == "less_than";
+      r.passed = less ? m->value < ref.value : m->value > ref.value;
+      comparable = comparable && std::isfinite(ref.value);
+      r.text = name + (less ? " < " : " > ") + e.ref_node + "." + e.ref_metric + " = " + fmt(ref.value);
+    } else if (e.op == "within_band" || e.op == "outside_band") {
       if (!m->has_band)
         throw ConfigError("expect: metric '" + e.metric + "' of '" + e.node + "' has no band; use min/max", e.loc);
       if (std::fabs(m->confidence - e.value) > 1e-9)
         throw ConfigError("expect asks for a " + fmt(e.value * 100) + " % band, but '" + e.node + "' computes its " +
                               e.metric + " band at " + fmt(m->confidence * 100) + " % (set its 'confidence' param)",
                           e.loc);
-      r.passed = m->value >= m->band_lo && m->value <= m->band_hi;
-      r.text = name + " in [" + fmt(m->band_lo) + ", " + fmt(m->band_hi) + "] (" + fmt(e.value * 100) + " % band)";
+      const bool inside = m->value >= m->band_lo && m->value <= m->band_hi;
+      r.passed = e.op == "within_band" ? inside : !inside;
+      r.text = name + (e.op == "within_band" ? " in [" : " outside [") + fmt(m->band_lo) + ", " + fmt(m->band_hi) +
+               "] (" + fmt(e.value * 100) + " % band)";
     } else {
       throw ConfigError("unknown expect check '" + e.op + "'", e.loc);
     }
-    if (!std::isfinite(m->value)) r.passed = false;
+    if (!comparable) r.passed = false;
     results.push_back(std::move(r));
   }
   return results;

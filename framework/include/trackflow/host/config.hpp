@@ -47,9 +47,12 @@ struct NodeConfig {
 struct ExpectConfig {
   std::string node;
   std::string metric;
-  std::string op;    // min, max, within_band, equals (with tolerance)
+  // min, max, within_band, outside_band, equals (with tolerance): against `value`;
+  // less_than, greater_than: against another metric `ref_node`.`ref_metric`.
+  std::string op;
   double value = 0;
   double tolerance = 0;
+  std::string ref_node, ref_metric;
   SourceLoc loc;
 };
 
