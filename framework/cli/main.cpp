@@ -1,4 +1,6 @@
 // Purpose: the `trackflow` command: run, validate, plugins, describe.
+#include "cli_common.hpp"
+
 #include <trackflow/host/engine.hpp>
 #include <trackflow/host/report.hpp>
 #include <trackflow/host/suggest.hpp>
@@ -16,13 +18,12 @@
 #include <sstream>
 #include <thread>
 
-namespace po = boost::program_options;
 using namespace trackflow;
 using namespace trackflow::host;
+using namespace trackflow::cli;
 
 namespace {
 
-constexpr int kOk = 0, kExpectFailed = 1, kBadInput = 2, kInternal = 3;
 
 const char* kTopHelp = R"(trackflow - plugin-based radar target-tracking pipelines
 
@@ -34,6 +35,7 @@ Commands:
   validate FILE   check a pipeline without running it (types, parameters, units, wiring)
   plugins         list the plugin files found and the component types they provide
   describe TYPE   show a component type's parameters (name, type, unit, default, doc)
+  sweep FILE      run a pipeline over a grid of parameter values, one table row per point
 
 Run `trackflow <command> --help` for the options of a command.
 
@@ -42,50 +44,6 @@ Exit codes: 0 ok, 1 an `expect` check failed, 2 bad configuration or input data,
 Plugins are searched in: --plugin-path DIRs, the pipeline's plugin_paths,
 $TRACKFLOW_PLUGIN_PATH (colon-separated), then <trackflow>/../lib/trackflow/plugins.
 )";
-
-struct Common {
-  std::vector<std::string> plugin_paths;
-  bool no_default_plugins = false;
-};
-
-po::options_description common_options(Common& c) {
-  po::options_description o("Plugin options");
-  o.add_options()("plugin-path", po::value(&c.plugin_paths)->composing(),
-                  "also search DIR for tfplugin_*.so (repeatable; searched first)")(
-      "no-default-plugins", po::bool_switch(&c.no_default_plugins),
-      "do not search $TRACKFLOW_PLUGIN_PATH or the built-in plugin folder");
-  return o;
-}
-
-PluginRegistry load_plugins(const Common& c, const std::vector<std::string>& pipeline_paths) {
-  std::vector<std::string> dirs = c.plugin_paths;
-  dirs.insert(dirs.end(), pipeline_paths.begin(), pipeline_paths.end());
-  if (!c.no_default_plugins) {
-    auto d = default_plugin_dirs();
-    dirs.insert(dirs.end(), d.begin(), d.end());
-  }
-  PluginRegistry reg;
-  reg.load_directories(dirs);
-  return reg;
-}
-
-void warn_problems(const PluginRegistry& reg) {
-  for (const auto& p : reg.problems()) std::cerr << "trackflow: warning: plugin not loaded: " << p.str() << "\n";
-}
-
-// Parses argv after the command word; prints help and returns false when asked.
-bool parse(int argc, char** argv, po::options_description& opts, po::positional_options_description& pos,
-           po::variables_map& vm, const std::string& usage) {
-  po::options_description all;
-  all.add(opts);
-  po::store(po::command_line_parser(argc, argv).options(all).positional(pos).run(), vm);
-  if (vm.count("help")) {
-    std::cout << usage << "\n" << opts << "\n";
-    return false;
-  }
-  po::notify(vm);
-  return true;
-}
 
 struct Loaded {
   PipelineConfig cfg;
@@ -320,8 +278,9 @@ int main(int argc, char** argv) {
     if (cmd == "validate") return cmd_validate(argc - 1, argv + 1);
     if (cmd == "plugins") return cmd_plugins(argc - 1, argv + 1);
     if (cmd == "describe") return cmd_describe(argc - 1, argv + 1);
+    if (cmd == "sweep") return cmd_sweep(argc - 1, argv + 1);
     std::cerr << "trackflow: unknown command '" << cmd << "'"
-              << did_you_mean(cmd, {"run", "validate", "plugins", "describe"}) << "\n\n" << kTopHelp;
+              << did_you_mean(cmd, {"run", "validate", "plugins", "describe", "sweep"}) << "\n\n" << kTopHelp;
     return kBadInput;
   } catch (const ConfigError& e) {
     std::cerr << "trackflow: error: " << e.message() << "\n";

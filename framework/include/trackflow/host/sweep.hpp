@@ -1,0 +1,23 @@
+// Purpose: parameter grids for `trackflow sweep`: parsing --param axes and enumerating the grid points.
+#pragma once
+
+#include <trackflow/host/config.hpp>
+
+#include <string>
+#include <vector>
+
+namespace trackflow::host {
+
+struct SweepAxis {
+  std::string node, param;
+  std::vector<std::string> values;  // YAML scalars or flow lists, as written
+};
+
+// "kf.q=0.01,0.1,1" -> {kf, q, [0.01, 0.1, 1]}. Commas inside [...] or {...} do not split, so
+// "radar.position=[0,0,0],[0,0,10]" has two values.
+SweepAxis parse_sweep_axis(const std::string& text);
+
+// The Cartesian product, first axis slowest: each point is one override per axis.
+std::vector<std::vector<Override>> sweep_grid(const std::vector<SweepAxis>& axes);
+
+}  // namespace trackflow::host

@@ -1,0 +1,46 @@
+// Purpose: parsing of sweep axes and enumeration of the grid.
+#include <trackflow/host/sweep.hpp>
+
+namespace trackflow::host {
+
+SweepAxis parse_sweep_axis(const std::string& text) {
+  const Override o = parse_override(text);
+  SweepAxis a{o.node, o.param, {}};
+  int depth = 0;
+  std::string cur;
+  for (char c : o.value) {
+    if (c == '[' || c == '{') ++depth;
+    if (c == ']' || c == '}') --depth;
+    if (c == ',' && depth == 0) {
+      a.values.push_back(cur);
+      cur.clear();
+    } else {
+      cur += c;
+    }
+  }
+  a.values.push_back(cur);
+  for (auto& v : a.values) {
+    const auto b = v.find_first_not_of(' '), e = v.find_last_not_of(' ');
+    v = b == std::string::npos ? std::string() : v.substr(b, e - b + 1);
+    if (v.empty()) throw ConfigError("--param '" + text + "': empty value in the list");
+  }
+  if (depth != 0) throw ConfigError("--param '" + text + "': unbalanced brackets");
+  return a;
+}
+
+std::vector<std::vector<Override>> sweep_grid(const std::vector<SweepAxis>& axes) {
+  std::vector<std::vector<Override>> grid(1);
+  for (const auto& a : axes) {
+    std::vector<std::vector<Override>> next;
+    for (const auto& point : grid)
+      for (const auto& v : a.values) {
+        auto p = point;
+        p.push_back({a.node, a.param, v});
+        next.push_back(std::move(p));
+      }
+    grid = std::move(next);
+  }
+  return grid;
+}
+
+}  // namespace trackflow::host
