@@ -81,3 +81,18 @@ TEST_CASE("Joseph update keeps P symmetric positive definite and matches the tex
   CHECK(Eigen::LLT<M::Matrix>(P).info() == Eigen::Success);
   CHECK(nis == Approx(nu.dot(S.inverse() * nu)));
 }
+
+TEST_CASE("structured covariance propagation equals F P F'") {
+  auto check = [](auto model) {
+    using M = decltype(model);
+    typename M::Matrix A = M::Matrix::Random();
+    typename M::Matrix P = A * A.transpose();
+    typename M::Matrix F;
+    M::transition(0.7, F);
+    const typename M::Matrix expected = F * P * F.transpose();
+    M::propagate_covariance(0.7, P);
+    CHECK((P - expected).norm() < 1e-12 * expected.norm());
+  };
+  check(ConstantVelocity{});
+  check(ConstantAcceleration{});
+}

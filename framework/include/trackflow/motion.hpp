@@ -90,10 +90,61 @@ struct KinematicModel {
     Q.setZero();
     for (int a = 0; a < 3; ++a) Q.template block<Order, Order>(a * Order, a * Order) = A;
   }
+  // P <- F P F' using the structure of F (identity plus T-multiples of the next derivative in
+  // each axis block): row operations for F P, then the same on columns for (F P) F'. About
+  // 10x fewer multiplications than two dense products; the result equals F P F' up to rounding.
+  static void propagate_covariance(double T, Matrix& P) {
+    const double h = 0.5 * T * T;
+    for (int a = 0; a < 3; ++a) {
+      const int i = a * Order;
+      if constexpr (Order == 3) {
+        P.row(i) += T * P.row(i + 1) + h * P.row(i + 2);
+        P.row(i + 1) += T * P.row(i + 2);
+      } else {
+        P.row(i) += T * P.row(i + 1);
+      }
+    }
+    for (int a = 0; a < 3; ++a) {
+      const int i = a * Order;
+      if constexpr (Order == 3) {
+        P.col(i) += T * P.col(i + 1) + h * P.col(i + 2);
+        P.col(i + 1) += T * P.col(i + 2);
+      } else {
+        P.col(i) += T * P.col(i + 1);
+      }
+    }
+  }
 };
 
 using ConstantVelocity = KinematicModel<2>;
 using ConstantAcceleration = KinematicModel<3>;
+
+namespace detail {
+constexpr double factorial(int n) {
+  double f = 1.0;
+  for (int i = 2; i <= n; ++i) f *= i;
+  return f;
+}
+inline constexpr int kSingerSeriesTerms = 18;
+// Singer's e^{As} b = [s^2 phi_2(alpha s), s phi_1(alpha s), phi_0(alpha s)]' = s^m_i sum_k (-alpha s)^k/(k+m_i)!
+// with m = (2, 1, 0); integrating the products over [0, T] gives
+// Q_ij = T^(m_i+m_j+1) sum_n (-x)^n c_ij[n],  c_ij[n] = sum_{k<=n} 1/((k+m_i)! (n-k+m_j)!) / (n+m_i+m_j+1),
+// stored for (i, j) = 00, 01, 02, 11, 12, 22.
+constexpr std::array<std::array<double, kSingerSeriesTerms>, 6> singer_series_coefficients() {
+  std::array<std::array<double, kSingerSeriesTerms>, 6> c{};
+  constexpr int m[3] = {2, 1, 0};
+  int ij = 0;
+  for (int i = 0; i < 3; ++i)
+    for (int j = i; j < 3; ++j, ++ij)
+      for (int n = 0; n < kSingerSeriesTerms; ++n) {
+        double inner = 0.0;
+        for (int k = 0; k <= n; ++k) inner += 1.0 / (factorial(k + m[i]) * factorial(n - k + m[j]));
+        c[ij][n] = inner / (n + m[i] + m[j] + 1);
+      }
+  return c;
+}
+inline constexpr auto kSingerSeries = singer_series_coefficients();
+}  // namespace detail
 
 // Singer (1970) model: per axis [p, v, a] with the layout and index helpers of
 // ConstantAcceleration, but the acceleration is a first-order Markov process
@@ -136,13 +187,12 @@ struct SingerModel {
     const double x = alpha * T;
     AxisMatrix Q;
     if (x < kSeriesLimit) {
-      static constexpr auto coeff = series_coefficients();
       constexpr int m[3] = {2, 1, 0};
       int ij = 0;
       for (int i = 0; i < 3; ++i)
         for (int j = i; j < 3; ++j, ++ij) {
           double sum = 0.0;  // Horner in -x
-          for (int n = kSeriesTerms - 1; n >= 0; --n) sum = sum * -x + coeff[ij][n];
+          for (int n = kSeriesTerms - 1; n >= 0; --n) sum = sum * -x + detail::kSingerSeries[ij][n];
           Q(i, j) = Q(j, i) = std::pow(T, m[i] + m[j] + 1) * sum;
         }
       return Q;
@@ -159,7 +209,7 @@ struct SingerModel {
   }
 
   static constexpr double kSeriesLimit = 0.5;
-  static constexpr int kSeriesTerms = 18;
+  static constexpr int kSeriesTerms = detail::kSingerSeriesTerms;
 
   // phi_m(x) = sum_k (-x)^k / (k+m)!, m = 0, 1, 2: e^-x, (1 - e^-x)/x, (x - 1 + e^-x)/x^2.
   static double phi(int m, double x) {
@@ -169,31 +219,8 @@ struct SingerModel {
       return m == 1 ? -em1 / x : (x + em1) / (x * x);
     }
     double sum = 0.0;
-    for (int k = kSeriesTerms - 1; k >= 0; --k) sum = sum * -x + 1.0 / factorial(k + m);
+    for (int k = kSeriesTerms - 1; k >= 0; --k) sum = sum * -x + 1.0 / detail::factorial(k + m);
     return sum;
-  }
-
- private:
-  static constexpr double factorial(int n) {
-    double f = 1.0;
-    for (int i = 2; i <= n; ++i) f *= i;
-    return f;
-  }
-  // e^{As} b = [s^2 phi_2(alpha s), s phi_1(alpha s), phi_0(alpha s)]' =: s^m_i sum_k (-alpha s)^k/(k+m_i)!
-  // with m = (2, 1, 0); integrating the products over [0, T] gives
-  // Q_ij = T^(m_i+m_j+1) sum_n (-x)^n / (n+m_i+m_j+1) * sum_{k<=n} 1/((k+m_i)! (n-k+m_j)!).
-  static constexpr std::array<std::array<double, kSeriesTerms>, 6> series_coefficients() {
-    std::array<std::array<double, kSeriesTerms>, 6> c{};
-    constexpr int m[3] = {2, 1, 0};
-    int ij = 0;
-    for (int i = 0; i < 3; ++i)
-      for (int j = i; j < 3; ++j, ++ij)
-        for (int n = 0; n < kSeriesTerms; ++n) {
-          double inner = 0.0;
-          for (int k = 0; k <= n; ++k) inner += 1.0 / (factorial(k + m[i]) * factorial(n - k + m[j]));
-          c[ij][n] = inner / (n + m[i] + m[j] + 1);
-        }
-    return c;
   }
 };
 

@@ -31,8 +31,11 @@ class KalmanFilter final : public Filter {
   explicit KalmanFilter(KalmanSettings s) : s_(std::move(s)) {
     H_.setZero();
     for (int a = 0; a < 3; ++a) H_(a, Model::position_index(a)) = 1.0;
-    est_.state.resize(N);
-    est_.covariance.resize(N, N);
+    // Published before initialisation too (initialised = false): keep it defined.
+    est_.state = StateN::Zero();
+    est_.covariance = MatN::Zero();
+    est_.enu.setZero();
+    est_.enu_covariance.setZero();
     est_.innovation.resize(3);
     est_.innovation_covariance.resize(3, 3);
     R_ = MeasCov::Zero(3, 3);
@@ -50,7 +53,7 @@ class KalmanFilter final : public Filter {
   void start_run(const RunContext& ctx) override {
     diag_ = ctx.diagnostics;
     points_ = 0;
-    last_T_ = -1.0;
+    have_time_ = false;
     if (!s_.two_point) {
       x_.setZero();
       P_.setZero();
@@ -65,7 +68,7 @@ class KalmanFilter final : public Filter {
         }
       }
       points_ = 2;
-      time_ = -std::numeric_limits<double>::infinity();
+      have_time_ = false;  // the explicit state holds at the first measurement's time
     }
   }
 
@@ -73,7 +76,7 @@ class KalmanFilter final : public Filter {
     if (m.frame != Frame::Cartesian)
       throw DataError("filter.kalman (node '" + s_.node +
                       "') needs Cartesian position measurements; put a convert.* node between the radar and it");
-    if (points_ >= 2 && m.time < time_) {
+    if (points_ >= 2 && have_time_ && m.time < time_) {
       if (diag_) diag_->skip(s_.node, "measurement at t=" + std::to_string(m.time) + " s is older than the track (t=" +
                                           std::to_string(time_) + " s)");
       return;
@@ -107,21 +110,21 @@ class KalmanFilter final : public Filter {
 
  private:
   void predict(double t) {
-    const double T = t - time_;
+    const double T = have_time_ ? t - time_ : 0.0;
     if (T > 0.0) {
-      if (T != last_T_) {  // fixed-rate data: F and Q are computed once
-        Model::transition(T, F_);
-        const auto Qa = s_.noise == KalmanSettings::Noise::Continuous ? Model::axis_noise_continuous(T, s_.q)
-                                                                       : Model::axis_noise_discrete(T, s_.sigma);
-        Model::block_diagonal(Qa, Q_);
+      if (T != last_T_) {  // fixed-rate data: the unit-intensity Q is computed once per T
+        unit_Q_ = s_.noise == KalmanSettings::Noise::Continuous ? Model::axis_noise_continuous(T, 1.0)
+                                                                 : Model::axis_noise_discrete(T, 1.0);
         last_T_ = T;
       }
+      // Scaled every step: an adapter may have changed q (or sigma) since the last one.
+      const double scale = s_.noise == KalmanSettings::Noise::Continuous ? s_.q : s_.sigma * s_.sigma;
       Model::propagate(T, x_);
-      const MatN FP = F_ * P_;
-      P_.noalias() = FP * F_.transpose();
-      P_ += Q_;
+      Model::propagate_covariance(T, P_);
+      for (int a = 0; a < 3; ++a) P_.template block<Model::kOrder, Model::kOrder>(a * Model::kOrder, a * Model::kOrder) += scale * unit_Q_;
     }
     time_ = t;
+    have_time_ = true;
   }
 
   // Two-point differencing (Bar-Shalom, Li & Kirubarajan 2001, §5.5.3): position from the
@@ -163,6 +166,7 @@ class KalmanFilter final : public Filter {
     }
     P_ = 0.5 * (P_ + P_.transpose()).eval();
     time_ = m.time;
+    have_time_ = true;
     points_ = 2;
     est_.updated = false;
     fill_estimate(m.time, true);
@@ -195,13 +199,13 @@ class KalmanFilter final : public Filter {
   KalmanSettings s_;
   StateN x_ = StateN::Zero();
   MatN P_ = MatN::Identity();
-  MatN F_ = MatN::Identity();
-  MatN Q_ = MatN::Zero();
+  typename Model::AxisMatrix unit_Q_ = Model::AxisMatrix::Zero();
   Mat3N H_;
   MeasCov R_;
   Estimate est_;
   Diagnostics* diag_ = nullptr;
   double time_ = 0.0, last_T_ = -1.0;
+  bool have_time_ = false;
   int points_ = 0;
   Vec3 z1_ = Vec3::Zero();
   Mat3 R1_ = Mat3::Zero();

@@ -178,3 +178,51 @@ TEST_CASE("wrong inputs and parameters are clear errors") {
   CHECK_THROWS_WITH(test::make("filter.kalman", "{ init: explicit }"), Catch::Contains("initial_position"));
   CHECK_THROWS_WITH(test::make("filter.kalman", "{ q: 1 m2/s3, sigma_accel: 1 m/s2 }"), Catch::Contains("not both"));
 }
+
+TEST_CASE("explicit initialisation holds at the first measurement's time (no infinite first step)") {
+  auto kf = test::make("filter.kalman", "{ init: explicit, initial_position: [0, 0, 0], initial_velocity: [10, 0, 0], "
+                                        "initial_sigma_position: 5 m, initial_sigma_velocity: 2 m/s }");
+  test::Collector out;
+  out.attach_to(*kf);
+  Diagnostics d;
+  kf->start_run({0, 1, &d});
+  kf->on_measurement(cartesian(100.0, Vec3(1, 0, 0), 3.0), 0);
+  kf->on_measurement(cartesian(101.0, Vec3(11, 0, 0), 3.0), 0);
+  REQUIRE(out.estimates.size() == 2);
+  for (const auto& e : out.estimates) {
+    CHECK(e.initialised);
+    CHECK(e.state.allFinite());
+    CHECK(e.covariance.allFinite());
+  }
+  CHECK(out.estimates[1].enu(0) == Approx(11).margin(2));
+}
+
+TEST_CASE("estimates published before initialisation carry defined (zero) state") {
+  auto kf = test::make("filter.kalman");
+  test::Collector out;
+  out.attach_to(*kf);
+  Diagnostics d;
+  kf->start_run({0, 1, &d});
+  kf->on_measurement(cartesian(0, Vec3(1, 2, 3), 1), 0);
+  REQUIRE(out.estimates.size() == 1);
+  CHECK_FALSE(out.estimates[0].initialised);
+  CHECK(out.estimates[0].state.size() == 6);
+  CHECK(out.estimates[0].state.isZero());
+  CHECK(out.estimates[0].enu_covariance.isZero());
+}
+
+TEST_CASE("a process-noise change through noise() takes effect at the next step even at a fixed T") {
+  auto run = [](double q_after) {
+    auto c = test::make("filter.kalman", "{ q: 1 m2/s3 }");
+    auto& f = dynamic_cast<Filter&>(*c);
+    test::Collector out;
+    out.attach_to(f);
+    Diagnostics d;
+    f.start_run({0, 1, &d});
+    for (int k = 0; k < 10; ++k) f.on_measurement(cartesian(k, Vec3(k, 0, 0), 1), 0);
+    *f.noise().process_noise = q_after;
+    f.on_measurement(cartesian(10, Vec3(10, 0, 0), 1), 0);
+    return out.estimates.back().enu_covariance(3, 3);
+  };
+  CHECK(run(100.0) > 2 * run(1.0));
+}

@@ -50,6 +50,8 @@ class RadarSource final : public Component {
         modes_(p, "mode_schedule", true),
         unlocked_(p, "invalid_schedule", false),
         default_mode_(mode_of(p.text("default_mode"))) {
+    report_nominal_ = p.text("reported_noise") == "nominal";
+    if (report_nominal_ && noise_.scale() == 0.0) throw p.error("noise_factor", "must not be 0 with reported_noise: nominal");
     shot_.enabled = p.boolean("shot_noise");
     shot_.length = p.integer("shot_length");
     shot_.period = p.integer("shot_period");
@@ -97,10 +99,13 @@ class RadarSource final : public Component {
     if (m_.has_range_rate) m_.value(3) = range_rate(d, t.velocity);
     add_noise(nominal.scaled(shot_.factor(emitted_)));
     m_.value(1) = wrap_angle(m_.value(1));
-    m_.covariance.diagonal()(0) = nominal.range * nominal.range;
-    m_.covariance.diagonal()(1) = nominal.azimuth * nominal.azimuth;
-    m_.covariance.diagonal()(2) = nominal.elevation * nominal.elevation;
-    if (m_.has_range_rate) m_.covariance.diagonal()(3) = nominal.range_rate * nominal.range_rate;
+    // reported_noise: nominal — a degraded radar that does not know it is degraded reports
+    // the sigma before noise_factor x noise_preset (paper 001 SCN.2/3).
+    const NoiseSigmas reported = report_nominal_ ? nominal.scaled(1.0 / noise_.scale()) : nominal;
+    m_.covariance.diagonal()(0) = reported.range * reported.range;
+    m_.covariance.diagonal()(1) = reported.azimuth * reported.azimuth;
+    m_.covariance.diagonal()(2) = reported.elevation * reported.elevation;
+    if (m_.has_range_rate) m_.covariance.diagonal()(3) = reported.range_rate * reported.range_rate;
     ++emitted_;
     out.emit(m_);
   }
@@ -143,6 +148,7 @@ class RadarSource final : public Component {
   MeasMode default_mode_;
   sim::ShotNoise shot_;
   AzimuthConvention convention_;
+  bool report_nominal_ = false;
   Rng rng_;
   long long received_ = 0;
   long long emitted_ = 0;  // measurements of this run so far: the shot-noise sample index
@@ -244,6 +250,10 @@ void register_components(Registrar& r) {
       ParamSpec::choice("noise_preset", {"none", "best", "normal", "worst"},
                         "paper 000 noise scale: best 0.5x, normal 1x, worst 2x sigma, times noise_factor")
           .def("none"),
+      ParamSpec::choice("reported_noise", {"actual", "nominal"},
+                        "covariance reported with each measurement: the sigma actually used, or the sigma before "
+                        "noise_factor x noise_preset (a degraded radar that does not know it)")
+          .def("actual"),
       ParamSpec::boolean("shot_noise", "add shot-noise bursts (paper 000 Case 1)").def("false"),
       ParamSpec::integer("shot_length", "shot noise: samples per burst (paper: 10)").def("10").at_least(1),
       ParamSpec::integer("shot_period", "shot noise: samples from one burst start to the next (paper: 4000)")

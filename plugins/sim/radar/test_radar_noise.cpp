@@ -233,6 +233,15 @@ TEST_CASE("noise presets and noise_factor multiply every sigma, in every model")
     CHECK(moments(eel).sd == Approx(20e-3).epsilon(sd_tolerance(eel.size())));
     CHECK(moments(err).sd == Approx(3).epsilon(sd_tolerance(err.size())));
   }
+  SECTION("reported_noise: nominal draws the degraded noise but reports the nominal covariance") {
+    const auto ms = measure(base + "noise_factor: 5\nreported_noise: nominal", truths, 8);
+    const Vec3 rae = exact(truths[0]);
+    std::vector<double> er;
+    for (const auto& m : ms) er.push_back(m.value(0) - rae(0));
+    CHECK(moments(er).sd == Approx(20).epsilon(sd_tolerance(er.size())));
+    const Eigen::Vector4d nominal = Eigen::Vector4d(4, 1e-3, 2e-3, 0.3).array().square();
+    CHECK(ms[0].covariance.diagonal().isApprox(nominal, 1e-12));
+  }
   SECTION("snr and table4 sigmas are scaled too") {
     const auto plain = measure("noise_model: snr", {truths[0]});
     const auto worse = measure("noise_model: snr\nnoise_preset: best\nnoise_factor: 3", {truths[0]});
