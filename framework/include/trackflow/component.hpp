@@ -157,6 +157,12 @@ class BOOST_SYMBOL_VISIBLE Filter : public Component {
  public:
   static constexpr int kMaxAdapters = 4;
   virtual NoiseHandles noise() { return {}; }
+  // Per-channel grade (e.g. BEST/NORMAL/WORST of a quality-switching adapter) that the next
+  // published Estimate carries in Estimate::quality; -1 = no grade. Adapters set it in
+  // before_update.
+  void set_quality(int channel, int grade) {
+    if (channel >= 0 && channel < 3) quality_[channel] = grade;
+  }
   // Engine side: returns false when the filter already has kMaxAdapters adapters.
   bool attach(Adapter* a) {
     if (adapter_count_ >= kMaxAdapters) return false;
@@ -168,8 +174,9 @@ class BOOST_SYMBOL_VISIBLE Filter : public Component {
   void before_update(const Measurement& m) {
     for (int i = 0; i < adapter_count_; ++i) adapters_[i]->before_update(m, *this);
   }
-  // Lets adapters see the result, then sends it downstream.
-  void publish(const Measurement& m, const Estimate& e) {
+  // Stamps the adapters' grades on `e`, lets adapters see the result, then sends it downstream.
+  void publish(const Measurement& m, Estimate& e) {
+    for (int c = 0; c < 3; ++c) e.quality[c] = quality_[c];
     for (int i = 0; i < adapter_count_; ++i) adapters_[i]->after_update(m, e, *this);
     out.emit(e);
   }
@@ -177,6 +184,7 @@ class BOOST_SYMBOL_VISIBLE Filter : public Component {
  private:
   Adapter* adapters_[kMaxAdapters] = {};
   int adapter_count_ = 0;
+  int quality_[3] = {-1, -1, -1};
 };
 
 inline void Outputs::emit(const Truth& t) const {

@@ -226,3 +226,20 @@ TEST_CASE("a process-noise change through noise() takes effect at the next step 
   };
   CHECK(run(100.0) > 2 * run(1.0));
 }
+
+TEST_CASE("grades set on the filter are carried by the next published estimate") {
+  auto c = test::make("filter.kalman");
+  auto& f = dynamic_cast<Filter&>(*c);
+  test::Collector out;
+  out.attach_to(f);
+  Diagnostics d;
+  f.start_run({0, 1, &d});
+  f.on_measurement(cartesian(0, Vec3(1, 2, 3), 1), 0);
+  CHECK(out.estimates.back().quality[0] == -1);
+  f.set_quality(0, 2);
+  f.set_quality(2, 0);
+  f.on_measurement(cartesian(1, Vec3(1, 2, 3), 1), 0);
+  CHECK(out.estimates.back().quality[0] == 2);
+  CHECK(out.estimates.back().quality[1] == -1);
+  CHECK(out.estimates.back().quality[2] == 0);
+}
