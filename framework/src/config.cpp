@@ -142,13 +142,24 @@ ExpectConfig parse_expect(const std::string& key, const SourceLoc& key_loc, cons
   e.metric = key.substr(dot + 1);
   if (v.kind != Value::Kind::Map || v.entries.empty())
     throw ConfigError("expect '" + key + "' must be a map such as { max: 25 } or { within_band: 0.95 }", v.loc);
-  static const std::vector<std::string> ops = {"min",    "max",       "within_band", "outside_band",
-                                               "equals", "tolerance", "less_than",   "greater_than"};
+  static const std::vector<std::string> ops = {"min",       "max",       "within_band",  "outside_band", "equals",
+                                               "tolerance", "less_than", "greater_than", "ratio_to"};
   reject_unknown_keys(v, ops, "expect '" + key + "'");
   // One check per entry would need a list; the usual {min, max} pair is split by the caller.
+  // With ratio_to, min/max bound metric / reference.
+  if (const Value* r = v.find("ratio_to")) {
+    const std::string ref = scalar(*r, "ratio_to");
+    const auto d = ref.find('.');
+    if (d == std::string::npos || d == 0 || d + 1 == ref.size())
+      throw ConfigError("expect '" + key + "': 'ratio_to' needs <node id>.<metric>, got '" + ref + "'", r->loc);
+    if (!v.find("min") && !v.find("max"))
+      throw ConfigError("expect '" + key + "': 'ratio_to' needs 'min' and/or 'max' bounds for the ratio", r->loc);
+    e.ref_node = ref.substr(0, d);
+    e.ref_metric = ref.substr(d + 1);
+  }
   for (size_t i = 0; i < v.entries.size(); ++i) {
     const auto& [op, val] = v.entries[i];
-    if (op == "tolerance") continue;
+    if (op == "tolerance" || op == "ratio_to") continue;
     if (op == "less_than" || op == "greater_than") {
       const std::string ref = scalar(val, op);
       const auto d = ref.find('.');
@@ -160,7 +171,7 @@ ExpectConfig parse_expect(const std::string& key, const SourceLoc& key_loc, cons
       continue;
     }
     try {
-      e.op = op;
+      e.op = e.ref_node.empty() || (op != "min" && op != "max") ? op : "ratio_" + op;
       e.value = std::stod(scalar(val, op));
     } catch (const ConfigError&) {
       throw;
@@ -301,6 +312,10 @@ PipelineConfig parse_pipeline(const Value& root, const std::string& file, const 
           one.loc = val.loc;
           one.entries.emplace_back(op, *val.find(op));
           one.key_locs.push_back(val.key_loc(op));
+          if (const Value* r = val.find("ratio_to")) {
+            one.entries.emplace_back("ratio_to", *r);
+            one.key_locs.push_back(val.key_loc("ratio_to"));
+          }
           cfg.expects.push_back(parse_expect(key, ex->key_locs[i], one));
         }
       } else {

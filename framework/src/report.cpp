@@ -92,6 +92,14 @@ std::vector<ExpectResult> check_expects(const Graph& g, const Outcome& out) {
     } else if (e.op == "equals") {
       r.passed = std::fabs(m->value - e.value) <= e.tolerance;
       r.text = name + " == " + fmt(e.value) + " ± " + fmt(e.tolerance);
+    } else if (e.op == "ratio_min" || e.op == "ratio_max") {
+      const Metric& ref = find_metric(out, e.ref_node, e.ref_metric, e.loc);
+      const double ratio = m->value / ref.value;
+      comparable = comparable && std::isfinite(ratio);
+      r.value = ratio;
+      r.passed = e.op == "ratio_min" ? ratio >= e.value : ratio <= e.value;
+      r.text = name + " / " + e.ref_node + "." + e.ref_metric + " = " + fmt(ratio) +
+               (e.op == "ratio_min" ? " >= " : " <= ") + fmt(e.value);
     } else if (e.op == "less_than" || e.op == "greater_than") {
       const Metric& ref = find_metric(out, e.ref_node, e.ref_metric, e.loc);
       const bool less = e.op == "less_than";
