@@ -21,7 +21,7 @@ struct DecoupledSettings {
 
 class DecoupledFilter final : public Filter {
  public:
-  explicit DecoupledFilter(DecoupledSettings s) : s_(std::move(s)) {
+  explicit DecoupledFilter(DecoupledSettings s) : s_(s), configured_(std::move(s)) {
     est_.state.resize(6);
     est_.covariance.resize(6, 6);
     est_.innovation.resize(3);
@@ -39,6 +39,10 @@ class DecoupledFilter final : public Filter {
   }
 
   void start_run(const RunContext& ctx) override {
+    // Adapters may have retuned the noise during the previous run on this instance; every run
+    // starts from the configured values, or results would depend on which thread ran what.
+    s_.q = configured_.q;
+    s_.sigma = configured_.sigma;
     diag_ = ctx.diagnostics;
     points_ = 0;
     last_T_ = -1.0;
@@ -160,6 +164,7 @@ class DecoupledFilter final : public Filter {
   }
 
   DecoupledSettings s_;
+  DecoupledSettings configured_;  // s_ as configured; s_.q and s_.sigma may be retuned by adapters
   DecoupledCv f_;
   decoupled::UpdateResult result_;
   decoupled::Mat2 Q_axis_ = decoupled::Mat2::Zero();

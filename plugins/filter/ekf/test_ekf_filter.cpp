@@ -10,80 +10,15 @@
 #include <numbers>
 
 #include "plugin_fixture.hpp"
+#include "radar_filter_test_support.hpp"
 
 using namespace trackflow;
+using namespace trackflow::filter_test;
 
 namespace {
 
-struct RadarNoise {
-  double range = 10.0, azimuth = 1e-3, elevation = 1e-3, range_rate = 0.5;
-};
-
-// A radar measurement built with geometry.hpp only (independent of spherical_measurement.hpp).
-Measurement radar(double t, const Vec3& pos, const Vec3& vel, const Vec3& sensor, const RadarNoise& s, Rng* rng,
-                  bool with_rr, AzimuthConvention c = AzimuthConvention::NorthClockwise) {
-  Measurement m;
-  m.time = t;
-  m.frame = Frame::Spherical;
-  m.azimuth = c;
-  m.sensor_position = sensor;
-  m.has_range_rate = with_rr;
-  const int n = with_rr ? 4 : 3;
-  m.value.resize(n);
-  const Vec3 rae = enu_to_spherical(pos - sensor, c);
-  m.value.head<3>() = rae;
-  if (with_rr) m.value(3) = range_rate(pos - sensor, vel);
-  m.covariance = MeasCov::Zero(n, n);
-  const double sig[4] = {s.range, s.azimuth, s.elevation, s.range_rate};
-  for (int i = 0; i < n; ++i) {
-    m.covariance(i, i) = sig[i] * sig[i];
-    if (rng) m.value(i) += sig[i] * rng->normal();
-  }
-  if (rng) m.value(1) = wrap_angle(m.value(1));
-  return m;
-}
-
-// Exact discretisation of a continuous white-noise model, per axis: w ~ N(0, Qa).
-template <int K>
-void add_process_noise(const Eigen::Matrix<double, K, K>& Qa, Eigen::Matrix<double, K, 1>* axes, Rng& rng) {
-  const Eigen::Matrix<double, K, K> L = Qa.llt().matrixL();
-  for (int a = 0; a < 3; ++a) {
-    Eigen::Matrix<double, K, 1> w;
-    for (int i = 0; i < K; ++i) w(i) = rng.normal();
-    axes[a] += L * w;
-  }
-}
-
-double nees(const Estimate& e, const Vec3& p, const Vec3& v) {
-  Vec6 err;
-  err << e.enu.head<3>() - p, e.enu.tail<3>() - v;
-  return err.dot(e.enu_covariance.ldlt().solve(err));
-}
-
-// 99 % two-sided band of chi2(k)/k (Wilson-Hilferty; accurate to < 1e-3 for k >= 100).
-std::pair<double, double> chi2_band(double k) {
-  const double z = 2.5758, c = 2.0 / (9.0 * k);
-  return {std::pow(1 - c - z * std::sqrt(c), 3), std::pow(1 - c + z * std::sqrt(c), 3)};
-}
-
-bool symmetric_pd(const StateCov& P) {
-  if (!P.allFinite()) return false;
-  if ((P - P.transpose()).norm() > 1e-12 * P.norm()) return false;
-  return Eigen::LLT<Eigen::MatrixXd>(Eigen::MatrixXd(P)).info() == Eigen::Success;
-}
-
-struct Run {
-  std::shared_ptr<Component> filter;
-  test::Collector out;
-  Diagnostics diag;
-  Run(const std::string& params, std::uint64_t run = 0) : filter(test::make("filter.ekf", params, "ekf")) {
-    out.attach_to(*filter);
-    filter->start_run({run, 1, &diag});
-  }
-  const Estimate& feed(const Measurement& m) {
-    filter->on_measurement(m, 0);
-    return out.estimates.back();
-  }
+struct Run : FilterRun {
+  Run(const std::string& params, std::uint64_t run = 0) : FilterRun("filter.ekf", params, run, "ekf") {}
 };
 
 // Textbook EKF (dynamic sizes, P = (I - KH) P, numerical Jacobian of geometry.hpp's h).

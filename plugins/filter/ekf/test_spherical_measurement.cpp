@@ -88,7 +88,7 @@ TEST_CASE("analytic Jacobian matches a numerical Jacobian, both conventions, wit
     }
 }
 
-TEST_CASE("paper 000 eq 3.24 as printed has a wrong rdot/z entry; the corrected one matches") {
+TEST_CASE("paper 000 eq 3.24 as printed has a wrong rdot/z entry, and the corrected one matches") {
   const Vec3 d(3e3, 4e3, 2e3), v(-50, 80, 30);
   const double x = d.x(), y = d.y(), z = d.z(), R = d.norm();
   const double printed = (v.z() * (x * x + y * y) - x * (x * v.x() + y * v.y())) / (R * R * R);

@@ -10,7 +10,7 @@ using namespace trackflow;
 
 TEST_CASE("paper 000 P0: symmetric positive definite, equal to the printed matrix except its (3,1) typo") {
   const double s2 = 4.0, T = 0.025;
-  const Eigen::Matrix3d P = ekf::paper000_axis_covariance(s2, T, T);
+  const Eigen::Matrix3d P = cartesian_filter::paper000_axis_covariance(s2, T, T);
   Eigen::Matrix3d printed;
   printed << s2, s2 / T, s2 / (T * T),                                //
       s2 / T, 2 * s2 / (T * T), 3 * s2 / (T * T * T),                 //
@@ -26,11 +26,11 @@ TEST_CASE("paper 000 P0: symmetric positive definite, equal to the printed matri
   CHECK(Eigen::LLT<Eigen::Matrix3d>(P).info() == Eigen::Success);
 }
 
-TEST_CASE("three-point differences recover a quadratic exactly in position and acceleration; P0 matches sample covariance") {
+TEST_CASE("three-point differences recover a quadratic exactly in position and acceleration, and P0 matches sample covariance") {
   const double T1 = 0.1, T2 = 0.15, p0 = 100, v0 = 30, a0 = -4;
   auto p = [&](double t) { return p0 + v0 * t + 0.5 * a0 * t * t; };
   const double t3 = T1 + T2;
-  const Eigen::Matrix3d A = ekf::three_point_differences(T1, T2);
+  const Eigen::Matrix3d A = cartesian_filter::three_point_differences(T1, T2);
   const Eigen::Vector3d s = A * Eigen::Vector3d(p(0), p(T1), p(t3));
   CHECK(s(0) == Approx(p(t3)));
   CHECK(s(2) == Approx(a0));
@@ -38,7 +38,7 @@ TEST_CASE("three-point differences recover a quadratic exactly in position and a
   CHECK(s(1) == Approx(v0 + a0 * (t3 - T2 / 2)));
 
   const double sigma = 3.0;
-  const Eigen::Matrix3d P = ekf::paper000_axis_covariance(sigma * sigma, T1, T2);
+  const Eigen::Matrix3d P = cartesian_filter::paper000_axis_covariance(sigma * sigma, T1, T2);
   Rng rng(5);
   const int n = 40000;
   Eigen::Matrix3d C = Eigen::Matrix3d::Zero();

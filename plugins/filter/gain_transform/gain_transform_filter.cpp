@@ -45,6 +45,8 @@ class GainTransformFilter final : public Filter {
   }
 
   void start_run(const RunContext& ctx) override {
+    // Adapters may have retuned sigma_m in the previous run on this instance.
+    for (double& q : q_) q = s_.sigma;
     diag_ = ctx.diagnostics;
     points_ = 0;
     last_T_ = -1.0;

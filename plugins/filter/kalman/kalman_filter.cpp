@@ -28,7 +28,7 @@ class KalmanFilter final : public Filter {
   using Mat3N = Eigen::Matrix<double, 3, N>;
 
  public:
-  explicit KalmanFilter(KalmanSettings s) : s_(std::move(s)) {
+  explicit KalmanFilter(KalmanSettings s) : s_(s), configured_(std::move(s)) {
     H_.setZero();
     for (int a = 0; a < 3; ++a) H_(a, Model::position_index(a)) = 1.0;
     // Published before initialisation too (initialised = false): keep it defined.
@@ -51,6 +51,10 @@ class KalmanFilter final : public Filter {
   }
 
   void start_run(const RunContext& ctx) override {
+    // Adapters may have retuned the noise during the previous run on this instance; every run
+    // starts from the configured values, or results would depend on which thread ran what.
+    s_.q = configured_.q;
+    s_.sigma = configured_.sigma;
     diag_ = ctx.diagnostics;
     points_ = 0;
     have_time_ = false;
@@ -197,6 +201,7 @@ class KalmanFilter final : public Filter {
   }
 
   KalmanSettings s_;
+  KalmanSettings configured_;  // s_ as configured; s_.q and s_.sigma may be retuned by adapters
   StateN x_ = StateN::Zero();
   MatN P_ = MatN::Identity();
   typename Model::AxisMatrix unit_Q_ = Model::AxisMatrix::Zero();

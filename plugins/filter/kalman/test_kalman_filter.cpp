@@ -243,3 +243,13 @@ TEST_CASE("grades set on the filter are carried by the next published estimate")
   CHECK(out.estimates.back().quality[1] == -1);
   CHECK(out.estimates.back().quality[2] == 0);
 }
+
+TEST_CASE("a process noise retuned by an adapter does not leak into the next run") {
+  auto c = test::make("filter.kalman", "{ q: 1 m2/s3 }");
+  auto& f = dynamic_cast<Filter&>(*c);
+  Diagnostics d;
+  f.start_run({0, 1, &d});
+  *f.noise().process_noise = 50.0;
+  f.start_run({1, 1, &d});
+  CHECK(*f.noise().process_noise == 1.0);
+}

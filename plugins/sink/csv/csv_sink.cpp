@@ -19,7 +19,7 @@ namespace {
 
 constexpr const char* kHeader =
     "run,time,source,kind,updated,x,y,z,vx,vy,vz,sigma_x,sigma_y,sigma_z,sigma_vx,sigma_vy,sigma_vz,nis,nees,"
-    "truth_x,truth_y,truth_z,truth_vx,truth_vy,truth_vz\n";
+    "truth_x,truth_y,truth_z,truth_vx,truth_vy,truth_vz,quality_range,quality_azimuth,quality_elevation\n";
 
 // Truth samples within this of an item's time are its truth (the same default as sink.metrics).
 constexpr double kTimeTolerance = 1e-6;
@@ -42,6 +42,7 @@ struct PendingRow {
   Vec6 value = Vec6::Zero();
   Vec6 sigma = Vec6::Zero();
   Mat6 covariance = Mat6::Zero();  // estimates: for NEES
+  int quality[3] = {-1, -1, -1};   // estimates: Estimate::quality, -1 = no grade
 };
 
 class CsvSink final : public Component {
@@ -99,6 +100,7 @@ class CsvSink final : public Component {
     r.has_sigma = true;
     for (int i = 0; i < 6; ++i) r.sigma(i) = e.enu_covariance(i, i) >= 0.0 ? std::sqrt(e.enu_covariance(i, i)) : NAN;
     r.covariance = e.enu_covariance;
+    for (int c = 0; c < 3; ++c) r.quality[c] = e.quality[c];
     flush(false);
   }
 
@@ -214,6 +216,12 @@ class CsvSink final : public Component {
     }
     w.real(nees);
     for (int i = 0; i < 6; ++i) w.real_if(t != nullptr, truth(i));
+    for (int c = 0; c < 3; ++c) {
+      if (r.quality[c] >= 0)
+        w.integer(static_cast<std::uint64_t>(r.quality[c]));
+      else
+        w.empty();
+    }
     w.end();
     ++row_count_;
   }
@@ -243,9 +251,12 @@ void register_components(Registrar& r) {
   d.kind = ComponentKind::Sink;
   d.summary = "Writes estimates (any number of filters), optional measurements and matching truth of all runs to one CSV file";
   d.doc =
-      "Columns: run,time,source,kind,updated,x,y,z,vx,vy,vz,sigma_x..sigma_vz,nis,nees,truth_x..truth_vz. source is "
+      "Columns: run,time,source,kind,updated,x,y,z,vx,vy,vz,sigma_x..sigma_vz,nis,nees,truth_x..truth_vz,"
+      "quality_range,quality_azimuth,quality_elevation. source is "
       "the upstream node id; kind is estimate or measurement. Truth columns and nees are filled when a truth sample "
-      "lies within 1 us of the row's time, nis when the estimate was updated; missing values are empty cells. "
+      "lies within 1 us of the row's time, nis when the estimate was updated; quality_* hold the per-channel grade "
+      "an adapter stamped on the estimate (Estimate::quality; adapt.quality_switch: 0 best, 1 normal, 2 worst), "
+      "empty when there is none; missing values are empty cells. "
       "Measurement rows carry the Cartesian position (spherical ones converted) and, when Cartesian, the sigmas "
       "of the covariance diagonal. Only initialised estimates and valid measurements are written. Rows are in "
       "run order, then arrival order, so the file is identical for a given seed whatever the thread count.";

@@ -25,8 +25,9 @@ const InputInfo kCm{"cm", "convert.classical", mask(ItemKind::Measurement)};
 
 const std::string kHeader =
     "run,time,source,kind,updated,x,y,z,vx,vy,vz,sigma_x,sigma_y,sigma_z,sigma_vx,sigma_vy,sigma_vz,nis,nees,"
-    "truth_x,truth_y,truth_z,truth_vx,truth_vy,truth_vz";
-enum Col { Run, Time, Source, Kind, Updated, X, Y, Z, VX, VY, VZ, SX, SY, SZ, SVX, SVY, SVZ, Nis, Nees, TX, TY, TZ, TVX, TVY, TVZ };
+    "truth_x,truth_y,truth_z,truth_vx,truth_vy,truth_vz,quality_range,quality_azimuth,quality_elevation";
+enum Col { Run, Time, Source, Kind, Updated, X, Y, Z, VX, VY, VZ, SX, SY, SZ, SVX, SVY, SVZ, Nis, Nees, TX, TY, TZ, TVX, TVY, TVZ,
+           QR, QAZ, QEL, Cells };
 
 // A folder of this test process, removed when the process exits.
 const fs::path& scratch_root() {
@@ -149,13 +150,13 @@ double num(const std::string& cell) { return std::stod(cell); }
 
 }  // namespace
 
-TEST_CASE("the file has the header, one row per estimate and run, 25 cells each, no nan") {
+TEST_CASE("the file has the header, one row per estimate and run, 28 cells each, no nan") {
   const fs::path dir = scratch("basic") / "nested";  // --out need not exist yet
   const std::string text = ensemble_file(dir, {0, 1, 2}, 1, [](std::uint64_t) { return 0; });
   const auto rows = parse(text);
   REQUIRE(rows.size() == 1 + 3 * 4);
   CHECK(text.substr(0, text.find('\n')) == kHeader);
-  for (const auto& r : rows) CHECK(r.size() == 25);
+  for (const auto& r : rows) CHECK(r.size() == Cells);
   CHECK(text.find("nan") == std::string::npos);
   CHECK(text.find("inf") == std::string::npos);
   // Run column, then arrival order within a run.
@@ -226,6 +227,30 @@ TEST_CASE("cells without a value are empty: no truth at that time, non-positive 
   CHECK(s.find("rows")->value == 2);
 }
 
+TEST_CASE("quality columns carry the grades an adapter stamped on the estimate, empty where there is none") {
+  const fs::path dir = scratch("quality");
+  auto c = make_csv("{}");
+  Diagnostics diag;
+  c->start_run({0, 1, &diag});
+  c->on_truth(truth(0.0, Vec3(1, 2, 3), Vec3::Zero()), 2);
+  Estimate graded = estimate(0.0, Vec6::Zero(), Mat6::Identity());
+  graded.quality[0] = 0;
+  graded.quality[1] = 2;
+  graded.quality[2] = -1;  // not graded yet
+  c->on_estimate(graded, 0);
+  c->on_estimate(estimate(0.0, Vec6::Zero(), Mat6::Identity()), 1);  // no adapter: -1 everywhere
+  auto result = c->end_run();
+  c->merge(*result);
+  Summary s;
+  c->finish(s, {"log", dir.string(), 1});
+  const auto rows = parse(slurp(dir / "log.csv"));
+  REQUIRE(rows.size() == 3);
+  CHECK(rows[1][QR] == "0");
+  CHECK(rows[1][QAZ] == "2");
+  CHECK(rows[1][QEL].empty());
+  for (int col : {QR, QAZ, QEL}) CHECK(rows[2][col].empty());
+}
+
 TEST_CASE("the file is byte-identical whatever the worker assignment, run order and item order within a step") {
   const std::string serial = ensemble_file(scratch("serial"), {0, 1, 2, 3}, 1, [](std::uint64_t) { return 0; });
   const std::string interleaved = ensemble_file(scratch("two"), {0, 1, 2, 3}, 2, [](std::uint64_t r) { return int(r % 2); });
@@ -277,7 +302,7 @@ TEST_CASE("measurement rows: Cartesian position, sigmas when Cartesian, truth, n
   CHECK(num(a[Z]) == 503);
   CHECK(num(a[SX]) == 2);
   CHECK(num(a[SZ]) == 4);
-  for (int col : {VX, VY, VZ, SVX, SVY, SVZ, Nis, Nees}) CHECK(a[col].empty());
+  for (int col : {VX, VY, VZ, SVX, SVY, SVZ, Nis, Nees, QR, QAZ, QEL}) CHECK(a[col].empty());
   CHECK(num(a[TX]) == 3000);
   CHECK(num(a[TVZ]) == 3);
   const auto& b = rows[2];

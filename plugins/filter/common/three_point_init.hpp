@@ -3,7 +3,7 @@
 
 #include <Eigen/Core>
 
-namespace trackflow::ekf {
+namespace trackflow::cartesian_filter {
 
 // Rows: position, velocity and acceleration at t3 as linear combinations of the positions
 // measured at t1, t2, t3 (T1 = t2 - t1, T2 = t3 - t2):
@@ -29,4 +29,4 @@ inline Eigen::Matrix3d paper000_axis_covariance(double sigma2, double T1, double
   return 0.5 * (P + P.transpose());
 }
 
-}  // namespace trackflow::ekf
+}  // namespace trackflow::cartesian_filter

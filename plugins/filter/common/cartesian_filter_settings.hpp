@@ -1,0 +1,134 @@
+// Purpose: settings of the Cartesian-state radar filters (filter.ekf, filter.ukf) — motion and noise model, range-rate use, initialisation — with their parameter declarations and parsing.
+#pragma once
+
+#include <trackflow/items.hpp>
+#include <trackflow/params.hpp>
+#include <trackflow/units.hpp>
+
+#include <string>
+#include <vector>
+
+namespace trackflow::cartesian_filter {
+
+struct Settings {
+  enum class Motion { ConstantVelocity, ConstantAcceleration, Singer } motion = Motion::ConstantVelocity;
+  // Continuous: q (CV, m2/s3) or q_jerk (CA, m2/s5); Discrete: sigma_accel; Singer: singer_sigma.
+  enum class Noise { Continuous, Discrete, Singer } noise = Noise::Continuous;
+  double intensity = 1.0;
+  double singer_alpha = 1.0;
+  enum class RangeRate { Auto, Use, Ignore } range_rate = RangeRate::Auto;
+  enum class Init { TwoPoint, Explicit, Paper000 } init = Init::TwoPoint;
+  Vec3 p0 = Vec3::Zero(), v0 = Vec3::Zero(), a0 = Vec3::Zero();
+  double sp0 = 0, sv0 = 0, sa0 = 0;  // initial standard deviations
+  std::string type;                  // component type, for messages ("filter.ekf")
+  std::string node;
+
+  int order() const { return motion == Motion::ConstantVelocity ? 2 : 3; }  // states per axis
+  int state_dim() const { return 3 * order(); }
+};
+
+// Motion, noise, range-rate and initialisation parameters every Cartesian radar filter takes.
+inline std::vector<ParamSpec> param_specs() {
+  return {
+      ParamSpec::choice("motion", {"constant_velocity", "constant_acceleration", "singer"}, "motion model")
+          .def("constant_velocity"),
+      ParamSpec::real("q", dim::accel_psd, "constant_velocity: spectral density of the white acceleration noise")
+          .def("1 m2/s3")
+          .at_least(0),
+      ParamSpec::real("q_jerk", dim::jerk_psd,
+                      "constant_acceleration: spectral density of the white jerk noise (paper 000 eq 3.19)")
+          .def("1 m2/s5")
+          .at_least(0),
+      ParamSpec::real("sigma_accel", dim::acceleration,
+                      "CV/CA discrete white-noise model instead: std of the acceleration (CV) or its increment (CA)")
+          .at_least(0),
+      ParamSpec::real("singer_alpha", dim::frequency, "singer: inverse correlation time of the acceleration, e.g. 1/s")
+          .positive(),
+      ParamSpec::real("singer_sigma", dim::acceleration, "singer: standard deviation sigma_m of the acceleration")
+          .positive(),
+      ParamSpec::choice("range_rate", {"auto", "use", "ignore"},
+                        "use the 4th element (range rate): when present (auto), always (use), never (ignore)")
+          .def("auto"),
+      ParamSpec::choice("init", {"two_point", "explicit", "paper000"},
+                        "two-point differencing, the initial_* values, or paper 000's three-point P0 (§IV.2.1)")
+          .def("two_point"),
+      ParamSpec::real_list("initial_position", dim::length, "init explicit: position (ENU)", 3),
+      ParamSpec::real_list("initial_velocity", dim::velocity, "init explicit: velocity", 3).def("[0, 0, 0]"),
+      ParamSpec::real_list("initial_acceleration", dim::acceleration, "init explicit, CA/Singer: acceleration", 3)
+          .def("[0, 0, 0]"),
+      ParamSpec::real("initial_sigma_position", dim::length, "init explicit: position std").positive(),
+      ParamSpec::real("initial_sigma_velocity", dim::velocity, "init explicit: velocity std").positive(),
+      ParamSpec::real("initial_sigma_acceleration", dim::acceleration,
+                      "CA/Singer, two_point or explicit: initial acceleration std (default 50 m/s2; Singer: singer_sigma)")
+          .positive(),
+  };
+}
+
+// Validates the combination of the parameters above (each one alone was checked by its ParamSpec).
+inline Settings parse_settings(const Params& p, std::string type) {
+  using S = Settings;
+  S s;
+  s.type = std::move(type);
+  s.node = p.node();
+  const std::string& motion = p.text("motion");
+  s.motion = motion == "constant_acceleration" ? S::Motion::ConstantAcceleration
+             : motion == "singer"              ? S::Motion::Singer
+                                               : S::Motion::ConstantVelocity;
+  const bool cv = s.motion == S::Motion::ConstantVelocity, ca = s.motion == S::Motion::ConstantAcceleration,
+             singer = s.motion == S::Motion::Singer;
+  if (!cv && p.given("q"))
+    throw p.error("q", "q (m2/s3) is the constant_velocity intensity; constant_acceleration takes q_jerk (m2/s5), "
+                       "singer takes singer_alpha and singer_sigma");
+  if (!ca && p.given("q_jerk")) throw p.error("q_jerk", "q_jerk is for motion: constant_acceleration");
+  if (singer && p.given("sigma_accel"))
+    throw p.error("sigma_accel", "sigma_accel is the discrete-noise alternative for constant_velocity and "
+                                 "constant_acceleration; the Singer noise is set by singer_sigma");
+  for (const char* name : {"singer_alpha", "singer_sigma"}) {
+    if (!singer && p.given(name)) throw p.error(name, std::string(name) + " is for motion: singer");
+    if (singer && !p.has(name)) throw p.error(name, "required with motion: singer");
+  }
+  if (p.given("sigma_accel") && (p.given("q") || p.given("q_jerk")))
+    throw p.error("sigma_accel", "give either a continuous-noise intensity (q / q_jerk) or sigma_accel, not both");
+  if (singer) {
+    s.noise = S::Noise::Singer;
+    s.intensity = p.real("singer_sigma");
+    s.singer_alpha = p.real("singer_alpha");
+  } else if (p.given("sigma_accel")) {
+    s.noise = S::Noise::Discrete;
+    s.intensity = p.real("sigma_accel");
+  } else {
+    s.intensity = ca ? p.real("q_jerk") : p.real("q");
+  }
+
+  const std::string& rr = p.text("range_rate");
+  s.range_rate = rr == "use" ? S::RangeRate::Use : rr == "ignore" ? S::RangeRate::Ignore : S::RangeRate::Auto;
+
+  const std::string& init = p.text("init");
+  s.init = init == "explicit" ? S::Init::Explicit : init == "paper000" ? S::Init::Paper000 : S::Init::TwoPoint;
+  const bool expl = s.init == S::Init::Explicit;
+  for (const char* name : {"initial_position", "initial_velocity", "initial_acceleration", "initial_sigma_position",
+                           "initial_sigma_velocity"})
+    if (!expl && p.given(name)) throw p.error(name, std::string(name) + " is only used with init: explicit");
+  if (expl)
+    for (const char* req : {"initial_position", "initial_sigma_position", "initial_sigma_velocity"})
+      if (!p.has(req)) throw p.error(req, "required with init: explicit");
+  if (cv && p.given("initial_acceleration"))
+    throw p.error("initial_acceleration", "the constant_velocity state has no acceleration");
+  if (p.given("initial_sigma_acceleration")) {
+    if (cv) throw p.error("initial_sigma_acceleration", "the constant_velocity state has no acceleration");
+    if (s.init == S::Init::Paper000)
+      throw p.error("initial_sigma_acceleration", "init: paper000 derives the acceleration variance from sigma and T");
+  }
+  if (expl) {
+    s.p0 = p.vec3("initial_position");
+    s.v0 = p.vec3("initial_velocity");
+    s.a0 = p.vec3("initial_acceleration");
+    s.sp0 = p.real("initial_sigma_position");
+    s.sv0 = p.real("initial_sigma_velocity");
+  }
+  // Unknown initial acceleration: Singer's stationary std is the natural prior.
+  s.sa0 = p.real_or("initial_sigma_acceleration", singer ? s.intensity : 50.0);
+  return s;
+}
+
+}  // namespace trackflow::cartesian_filter

@@ -1,0 +1,173 @@
+// Purpose: filter.ukf — scaled unscented Kalman filter with a Cartesian ENU state (CV, CA or Singer motion) on spherical [r, az, el(, rdot)] measurements.
+#include "cartesian_radar_filter.hpp"
+#include "unscented_transform.hpp"
+
+#include <trackflow/kalman.hpp>
+#include <trackflow/plugin.hpp>
+#include <trackflow/spherical_measurement.hpp>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
+
+#include <algorithm>
+#include <cstdio>
+#include <string>
+
+namespace trackflow {
+namespace {
+
+struct UnscentedSettings {
+  double alpha = 1.0, beta = 2.0, kappa = 0.0;
+};
+
+// Settings, measurement checks, initialisation, prediction and publishing: cartesian_radar_filter.hpp.
+// The prediction there is the linear F x, F P F' + Q: for a linear map the unscented transform
+// returns exactly these moments, so sigma points are used only for the nonlinear h.
+template <int Order>
+class UnscentedKalmanFilter final
+    : public cartesian_filter::CartesianRadarFilter<Order, UnscentedKalmanFilter<Order>> {
+  using Base = cartesian_filter::CartesianRadarFilter<Order, UnscentedKalmanFilter<Order>>;
+  friend Base;
+  using Base::N;
+  using Base::x_;
+  using Base::P_;
+  using Base::R_;
+  using Base::idx_;
+  using Layout = typename Base::Layout;
+  using StateN = typename Base::StateN;
+  using MatN = typename Base::MatN;
+
+ public:
+  UnscentedKalmanFilter(cartesian_filter::Settings s, UnscentedSettings u)
+      : Base(std::move(s)), weights_(ukf::ScaledWeights::make(N, u.alpha, u.beta, u.kappa)) {}
+
+  std::unique_ptr<RunResult> end_run() override {
+    // Numerical repairs are counted rather than reported at every step.
+    if (jitter_count_ > 0) {
+      char buf[48];
+      std::snprintf(buf, sizeof buf, "%.3g", max_jitter_);
+      this->warn("state covariance not numerically positive definite at " + std::to_string(jitter_count_) + " of " +
+                 std::to_string(updates_) + " updates: symmetrised, up to " + buf +
+                 " added to its diagonal before drawing sigma points");
+    }
+    if (spread_clamped_count_ > 0)
+      this->warn("negative centre weight W0c = " + std::to_string(weights_.cov0) +
+                 " made R plus the unscented spread indefinite (P - K S K' could lose definiteness) at " +
+                 std::to_string(spread_clamped_count_) + " of " + std::to_string(updates_) +
+                 " updates; its negative part was removed there (see alpha, beta, kappa)");
+    return nullptr;
+  }
+
+ private:
+  void on_start_run() {
+    jitter_count_ = spread_clamped_count_ = updates_ = 0;
+    max_jitter_ = 0.0;
+  }
+
+  template <int M>
+  void update(const Measurement& m) {
+    using MatM = Eigen::Matrix<double, M, M>;
+    ++updates_;
+    const double jitter = ukf::guarded_cholesky<N>(P_, llt_);
+    if (jitter < 0.0) {
+      this->warn("state covariance at t=" + std::to_string(m.time) +
+                 " s cannot be factored for sigma points; measurement not used");
+      return;
+    }
+    if (jitter > 0.0) {
+      ++jitter_count_;
+      max_jitter_ = std::max(max_jitter_, jitter);
+    }
+    const MatN L = llt_.matrixL();
+    const Vec3 sensor = m.sensor_position;
+    const AzimuthConvention convention = m.azimuth;
+    const int* idx = idx_;
+    auto h = [sensor, convention, idx](const StateN& s) {
+      const Vec3 d = Vec3(s(idx[0]), s(idx[1]), s(idx[2])) - sensor;
+      const Vec3 v(s(idx[3]), s(idx[4]), s(idx[5]));
+      return spherical_measurement<M>(d, v, convention);
+    };
+    ukf::MeasurementMoments<N, M> ut;
+    ukf::unscented_measurement<N, M>(x_, L, weights_, h, ut);
+    const SphericalVec<M> z = m.value.template head<M>();
+    const SphericalVec<M> nu = spherical_residual<M>(z, ut.mean);
+    // The Joseph form with the statistically linearised H and R + extra gives the textbook
+    // UKF's gain P_xz S^-1 and its P - K S K', but as a sum of two positive semi-definite
+    // terms (unscented_transform.hpp; docs/filters.md).
+    MatM R = R_.topLeftCorner(M, M);
+    R += ut.extra;
+    // A negative W0c can make R + extra indefinite, and with it P - K S K'. Then the negative
+    // part of `extra` is removed (eigenvalues clamped at 0), so R + extra >= R.
+    if (weights_.cov0 < 0.0 && Eigen::LLT<MatM>(R).info() != Eigen::Success) {
+      const Eigen::SelfAdjointEigenSolver<MatM> eig(ut.extra);
+      R = R_.topLeftCorner(M, M);
+      R += eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() * eig.eigenvectors().transpose();
+      ++spread_clamped_count_;
+    }
+    MatM S;
+    double nis = 0.0;
+    if (joseph_update<N, M>(x_, P_, nu, ut.H, R, S, nis))
+      this->template accept_update<M>(nu, S, nis);
+    else
+      this->warn("innovation covariance not positive definite at t=" + std::to_string(m.time) +
+                 " s; measurement not used");
+  }
+
+  ukf::ScaledWeights weights_;
+  Eigen::LLT<MatN> llt_;
+  int jitter_count_ = 0, spread_clamped_count_ = 0, updates_ = 0;
+  double max_jitter_ = 0.0;
+};
+
+std::unique_ptr<Component> create(const Params& p) {
+  const cartesian_filter::Settings s = cartesian_filter::parse_settings(p, "filter.ukf");
+  const int n = s.state_dim();
+  UnscentedSettings u;
+  u.alpha = p.real("alpha");
+  u.beta = p.real("beta");
+  u.kappa = p.real_or("kappa", 3.0 - n);
+  if (!(n + u.kappa > 0.0))
+    throw p.error("kappa", "kappa must exceed -n = " + std::to_string(-n) + " (the state has n = " +
+                               std::to_string(n) + " elements): the sigma points lie at sqrt(alpha^2 (n + kappa)) "
+                               "standard deviations");
+  if (s.order() == 2) return std::make_unique<UnscentedKalmanFilter<2>>(s, u);
+  return std::make_unique<UnscentedKalmanFilter<3>>(s, u);
+}
+
+void register_components(Registrar& r) {
+  ComponentDecl d;
+  d.type = "filter.ukf";
+  d.kind = ComponentKind::Filter;
+  d.summary = "Scaled unscented Kalman filter: Cartesian ENU state (CV, CA or Singer) on spherical "
+              "[r, az, el(, rdot)] measurements";
+  d.doc =
+      "Same state, motion models, initialisation, coasting and noise handles as filter.ekf; the prediction is linear "
+      "(exact for these models). The measurement h(x) = [r, az, el(, rdot)] goes through the scaled unscented "
+      "transform (Wan & van der Merwe 2000; Julier 2002): 2n+1 sigma points x, x +- sqrt(n+lambda) L_j from the "
+      "Cholesky factor of P, lambda = alpha^2 (n + kappa) - n, weights W0m = lambda/(n+lambda), "
+      "W0c = W0m + 1 - alpha^2 + beta, Wi = 1/(2(n+lambda)). Azimuths are averaged relative to the centre point's "
+      "(no +-pi cut) and every residual's azimuth is wrapped to (-pi, pi]. Update in Joseph form with the "
+      "statistically linearised H = P_zx P^-1 and R plus the unexplained spread (equal to P - K S K', kept "
+      "positive semi-definite). Defaults alpha 1, beta 2, kappa 3 - n: sigma points at sqrt(3) sigma (the Gaussian's "
+      "fourth moment, Julier & Uhlmann 2004) and non-negative covariance weights for n <= 9. See docs/filters.md.";
+  d.accepts = mask(ItemKind::Measurement);
+  d.produces = mask(ItemKind::Estimate);
+  d.params = cartesian_filter::param_specs();
+  d.params.push_back(ParamSpec::real("alpha", dim::none,
+                                     "spread of the sigma points (scaled UT); 1 keeps them at sqrt(n + kappa) sigma, "
+                                     "small values (1e-3) make W0 large and negative")
+                         .def("1")
+                         .positive());
+  d.params.push_back(ParamSpec::real("beta", dim::none,
+                                     "knowledge of the distribution in the centre covariance weight (2: Gaussian)")
+                         .def("2"));
+  d.params.push_back(ParamSpec::real("kappa", dim::none,
+                                     "secondary scaling; n + kappa > 0 (default 3 - n: -3 for CV, -6 for CA/Singer)"));
+  d.create = create;
+  r.add(std::move(d));
+}
+
+}  // namespace
+}  // namespace trackflow
+
+TRACKFLOW_PLUGIN("filter.ukf", trackflow::register_components)

@@ -1,0 +1,124 @@
+// Purpose: the scaled unscented transform (Julier 2002; Wan & van der Merwe 2000) of the spherical radar measurement: weights, a guarded Cholesky factor, and the angle-aware predicted measurement moments.
+#pragma once
+
+#include <trackflow/geometry.hpp>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
+#include <cmath>
+
+namespace trackflow::ukf {
+
+// Weights of the 2n+1 sigma points x, x ± c L_j (L L' = P):
+//   lambda = alpha^2 (n + kappa) - n,   c^2 = n + lambda,
+//   W0m = lambda / (n + lambda),   W0c = W0m + 1 - alpha^2 + beta,   Wi = 1 / (2 (n + lambda)).
+struct ScaledWeights {
+  int n = 0;
+  double lambda = 0.0, spread = 0.0;  // spread = c = sqrt(n + lambda)
+  double mean0 = 0.0, cov0 = 0.0, other = 0.0;
+
+  static ScaledWeights make(int n, double alpha, double beta, double kappa) {
+    ScaledWeights w;
+    w.n = n;
+    w.lambda = alpha * alpha * (n + kappa) - n;
+    const double nl = n + w.lambda;  // = alpha^2 (n + kappa) > 0, checked by the caller
+    w.spread = std::sqrt(nl);
+    w.mean0 = w.lambda / nl;
+    w.cov0 = w.mean0 + 1.0 - alpha * alpha + beta;
+    w.other = 0.5 / nl;
+    return w;
+  }
+};
+
+// Cholesky factor of P for the sigma points. If P is not numerically positive definite it is
+// symmetrised and a growing multiple of its largest variance (1e-12 ... 1e-4) is added to the
+// diagonal; P itself is replaced by the matrix that was factored, so the sigma points and the
+// update describe the same covariance. Returns the jitter added (0: none) or -1 if P could not
+// be factored (non-finite, or indefinite beyond 1e-4 of its scale).
+template <int N>
+double guarded_cholesky(Eigen::Matrix<double, N, N>& P, Eigen::LLT<Eigen::Matrix<double, N, N>>& llt) {
+  if (!P.allFinite()) return -1.0;  // LLT would "succeed" on a NaN diagonal (NaN <= 0 is false)
+  llt.compute(P);
+  if (llt.info() == Eigen::Success) return 0.0;
+  P = (0.5 * (P + P.transpose())).eval();
+  const double scale = P.diagonal().cwiseAbs().maxCoeff();
+  if (!(scale > 0.0)) return -1.0;
+  for (double rel = 1e-12; rel <= 1.001e-4; rel *= 100.0) {
+    Eigen::Matrix<double, N, N> Pj = P;
+    Pj.diagonal().array() += rel * scale;
+    llt.compute(Pj);
+    if (llt.info() == Eigen::Success) {
+      P = Pj;
+      return rel * scale;
+    }
+  }
+  return -1.0;
+}
+
+// Moments of z = h(x), x ~ N(mean, L L'), by the scaled unscented transform, in the form the
+// Joseph update takes:
+//   mean  = sum W_m Z_i (the azimuth, element 1, averaged in a chart without the ±pi cut)
+//   H     = P_zx P^-1, the statistical linearisation (P_zx = sum W_c dZ_i dX_i')
+//   extra = sum W_c (dZ_i - H dX_i)(dZ_i - H dX_i)': the spread the linear part does not explain
+// so that P_zz = H P H' + extra and P_xz = P H'. With dX_{±j} = ±c L_j:
+//   H L = G',  G_j = (dZ_{+j} - dZ_{-j})' / (2c)     (central differences along the sigma directions)
+//   extra = W0c dZ_0 dZ_0' + 2 Wi sum_j s_j s_j',  s_j = (dZ_{+j} + dZ_{-j}) / 2
+// "extra" is a sum of outer products: positive semi-definite whenever W0c >= 0, with no
+// cancellation (unlike P_zz - H P H').
+template <int N, int M>
+struct MeasurementMoments {
+  Eigen::Matrix<double, M, 1> mean;
+  Eigen::Matrix<double, M, N> H;
+  Eigen::Matrix<double, M, M> extra;
+};
+
+// h(const Eigen::Matrix<double, N, 1>&) -> Eigen::Matrix<double, M, 1> with the azimuth in
+// element 1 (the SDK's spherical layout [r, az, el(, rdot)]).
+template <int N, int M, class MeasurementFn>
+void unscented_measurement(const Eigen::Matrix<double, N, 1>& x, const Eigen::Matrix<double, N, N>& L,
+                           const ScaledWeights& w, MeasurementFn&& h, MeasurementMoments<N, M>& out) {
+  using VecM = Eigen::Matrix<double, M, 1>;
+  using VecN = Eigen::Matrix<double, N, 1>;
+  const double c = w.spread;
+  const VecM z0 = h(x);
+  VecM zp[N], zm[N];
+  // Azimuths are taken relative to the centre point's and wrapped: every sigma point lies
+  // within pi of it, so the weighted average is an ordinary one in a chart where the ±pi cut
+  // does not occur (the plain weighted mean wherever the points spread over less than pi). The
+  // circular mean atan2(sum W sin, sum W cos) is the direction of the weighted resultant instead:
+  // it differs from the mean once the points lie unevenly, and with a negative W0 it is not an
+  // average at all.
+  VecM sum = VecM::Zero();
+  for (int j = 0; j < N; ++j) {
+    const VecN step = c * L.col(j);
+    zp[j] = h(VecN(x + step));
+    zm[j] = h(VecN(x - step));
+    zp[j](1) = z0(1) + wrap_angle(zp[j](1) - z0(1));
+    zm[j](1) = z0(1) + wrap_angle(zm[j](1) - z0(1));
+    sum += zp[j] + zm[j];
+  }
+  VecM mean = w.mean0 * z0 + w.other * sum;
+  // Residuals of each point from the mean, azimuth wrapped to (-pi, pi].
+  auto residual = [&mean](const VecM& z) {
+    VecM d = z - mean;
+    d(1) = wrap_angle(d(1));
+    return d;
+  };
+  const VecM d0 = residual(z0);
+  Eigen::Matrix<double, N, M> G;
+  out.extra.setZero();
+  for (int j = 0; j < N; ++j) {
+    const VecM dp = residual(zp[j]), dm = residual(zm[j]);
+    G.row(j) = (dp - dm).transpose() / (2.0 * c);
+    const VecM s = 0.5 * (dp + dm);
+    out.extra.noalias() += (2.0 * w.other) * s * s.transpose();
+  }
+  out.extra.noalias() += w.cov0 * d0 * d0.transpose();
+  // H = G' L^-1, i.e. L' H' = G.
+  out.H.transpose() = L.transpose().template triangularView<Eigen::Upper>().solve(G);
+  mean(1) = wrap_angle(mean(1));
+  out.mean = mean;
+}
+
+}  // namespace trackflow::ukf
