@@ -7,6 +7,7 @@
 #include <trackflow/error.hpp>
 #include <trackflow/geometry.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 #include <utility>
@@ -17,7 +18,8 @@ using ConversionFn = ConvertedPosition (*)(double r, double az, double el, const
                                            AzimuthConvention);
 
 // Converts spherical measurements [r, az, el(, ρ)] with `convert`. Only the diagonal of the
-// (r, az, el) covariance is used: the three papers assume independent errors. Range rate ρ is
+// (r, az, el) covariance is used: the three papers assume independent errors. Measurements
+// whose errors are correlated anyway are counted and reported as a warning at the end of the run. Range rate ρ is
 // measured directly, so its value and variance pass unchanged; its covariance with the
 // position is the Stein's-lemma term of ConvertedPosition (zero when the input has none).
 class StatisticalConverter final : public Component {
@@ -25,12 +27,28 @@ class StatisticalConverter final : public Component {
   StatisticalConverter(std::string type, std::string node, ConversionFn convert)
       : type_(std::move(type)), node_(std::move(node)), convert_(convert) {}
 
+  void start_run(const RunContext& ctx) override {
+    diagnostics_ = ctx.diagnostics;
+    correlated_ = 0;
+    largest_correlation_ = 0.0;
+  }
+
+  std::unique_ptr<RunResult> end_run() override {
+    if (correlated_ > 0 && diagnostics_)
+      diagnostics_->warn(node_, std::to_string(correlated_) +
+                                    " measurement(s) had correlated (r, az, el) errors (largest |rho| = " +
+                                    std::to_string(largest_correlation_) + "); " + type_ +
+                                    " used only their variances");
+    return nullptr;
+  }
+
   void on_measurement(const Measurement& in, int) override {
     if (in.frame == Frame::Cartesian || !in.valid) {
       out.emit(in);  // already Cartesian, or nothing to convert: pass on unchanged
       return;
     }
     check(in);
+    note_correlation(in);
     const int n = static_cast<int>(in.value.size());
     const double r = in.value(0), az = in.value(1), el = in.value(2);
     const SphericalVariances v{in.covariance(0, 0), in.covariance(1, 1), in.covariance(2, 2)};
@@ -67,6 +85,18 @@ class StatisticalConverter final : public Component {
     for (int i = 0; i < n; ++i)
       if (in.covariance(i, i) < 0.0) fail(in, "has a negative variance at index " + std::to_string(i));
   }
+  void note_correlation(const Measurement& in) {
+    double largest = 0.0;
+    for (int i = 0; i < 3; ++i)
+      for (int j = i + 1; j < 3; ++j) {
+        const double d = std::sqrt(in.covariance(i, i) * in.covariance(j, j));
+        if (d > 0.0) largest = std::max(largest, std::abs(in.covariance(i, j)) / d);
+      }
+    if (largest > 1e-9) {
+      ++correlated_;
+      largest_correlation_ = std::max(largest_correlation_, largest);
+    }
+  }
   [[noreturn]] void fail(const Measurement& in, const std::string& what) const {
     throw DataError(type_ + " (node '" + node_ + "'): spherical measurement at t=" + std::to_string(in.time) +
                     " s from sensor " + std::to_string(in.sensor) + " " + what);
@@ -76,6 +106,9 @@ class StatisticalConverter final : public Component {
   std::string node_;
   ConversionFn convert_;
   Measurement m_;
+  Diagnostics* diagnostics_ = nullptr;
+  long long correlated_ = 0;
+  double largest_correlation_ = 0.0;
 };
 
 }  // namespace trackflow::conversion

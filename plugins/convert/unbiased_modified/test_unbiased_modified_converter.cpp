@@ -93,3 +93,27 @@ TEST_CASE("shared behaviour: pass-through, bad data, small-error limit, azimuth 
   check_small_error_limit(kType);
   check_convention_equivalence(kType);
 }
+
+TEST_CASE("correlated (r, az, el) errors are converted with their variances and reported, not ignored silently") {
+  auto conv = trackflow::test::make("convert.unbiased_modified");
+  trackflow::test::Collector out;
+  out.attach_to(*conv);
+  auto measure = [&](double correlation) {
+    trackflow::Diagnostics d;
+    conv->start_run({0, 1, &d});
+    trackflow::Measurement m;
+    m.frame = trackflow::Frame::Spherical;
+    m.value = trackflow::Vec3(20e3, 0.5, 0.1);
+    m.covariance = trackflow::MeasCov::Zero(3, 3);
+    m.covariance.diagonal() << 100.0, 1e-6, 1e-6;
+    m.covariance(0, 1) = m.covariance(1, 0) = correlation * std::sqrt(100.0 * 1e-6);
+    conv->on_measurement(m, 0);
+    conv->end_run();
+    return d.warnings;
+  };
+  CHECK(measure(0.0).empty());
+  const auto w = measure(0.3);
+  REQUIRE(w.size() == 1);
+  CHECK(w[0].message.find("1 measurement(s) had correlated") != std::string::npos);
+  CHECK(w[0].message.find("0.3") != std::string::npos);
+}
