@@ -80,4 +80,19 @@ struct Estimate {
   int quality[3] = {-1, -1, -1};  // per-channel grade set by quality adapters, -1: none
 };
 
+// What a filter publishes while it is still collecting its first points: flagged, with a
+// zero state of the filter's size and no innovation (never the previous run's values).
+inline void set_uninitialised(Estimate& e, double time) {
+  e.time = time;
+  e.updated = false;
+  e.initialised = false;
+  e.state.setZero();
+  e.covariance.setZero();
+  e.enu.setZero();
+  e.enu_covariance.setZero();
+  e.innovation.resize(0);
+  e.innovation_covariance.resize(0, 0);
+  e.nis = 0.0;
+}
+
 }  // namespace trackflow

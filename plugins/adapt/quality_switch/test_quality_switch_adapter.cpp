@@ -1,4 +1,4 @@
-// Purpose: tests of adapt.quality_switch on filter.ekf and a stub filter: q and R written, grades at the thresholds, beacon/skin tables, invalid samples, a whole pipeline.
+// Purpose: tests of adapt.quality_switch on filter.ekf and a minimal hand-written filter: q and R written, grades at the thresholds, beacon/skin tables, invalid samples, a whole pipeline.
 #include <trackflow/geometry.hpp>
 #include <trackflow/host/engine.hpp>
 #include <trackflow/host/graph.hpp>

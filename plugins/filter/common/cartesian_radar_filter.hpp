@@ -287,13 +287,7 @@ class CartesianRadarFilter : public Filter {
 
   // No state yet: publish zeros rather than whatever the previous run left.
   void publish_uninitialised(const Measurement& m) {
-    est_.state.setZero();
-    est_.covariance.setZero();
-    est_.enu.setZero();
-    est_.enu_covariance.setZero();
-    est_.time = m.time;
-    est_.initialised = false;
-    clear_innovation();
+    set_uninitialised(est_, m.time);
     publish(m, est_);
   }
 

@@ -140,10 +140,7 @@ class DecoupledFilter final : public Filter {
   }
 
   void publish_uninitialised(const Measurement& m) {
-    est_.time = m.time;
-    est_.updated = false;
-    est_.initialised = false;
-    est_.nis = 0.0;
+    set_uninitialised(est_, m.time);
     publish(m, est_);
   }
 

@@ -246,16 +246,7 @@ class GainTransformFilter final : public Filter {
   }
 
   void publish_uninitialised(const Measurement& m) {
-    est_.state.setZero();
-    est_.covariance.setZero();
-    est_.enu.setZero();
-    est_.enu_covariance.setZero();
-    est_.time = m.time;
-    est_.updated = false;
-    est_.initialised = false;
-    est_.innovation.resize(0);
-    est_.innovation_covariance.resize(0, 0);
-    est_.nis = 0.0;
+    set_uninitialised(est_, m.time);
     publish(m, est_);
   }
 

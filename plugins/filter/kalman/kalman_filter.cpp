@@ -178,10 +178,7 @@ class KalmanFilter final : public Filter {
   }
 
   void publish_uninitialised(const Measurement& m) {
-    est_.time = m.time;
-    est_.updated = false;
-    est_.initialised = false;
-    est_.nis = 0.0;
+    set_uninitialised(est_, m.time);
     publish(m, est_);
   }
 

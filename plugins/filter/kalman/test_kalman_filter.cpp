@@ -209,6 +209,13 @@ TEST_CASE("estimates published before initialisation carry defined (zero) state"
   CHECK(out.estimates[0].state.size() == 6);
   CHECK(out.estimates[0].state.isZero());
   CHECK(out.estimates[0].enu_covariance.isZero());
+  // A second run on the same instance must not show the first run's track.
+  for (int k = 1; k < 5; ++k) kf->on_measurement(cartesian(k, Vec3(1 + k, 2, 3), 1), 0);
+  kf->start_run({1, 1, &d});
+  kf->on_measurement(cartesian(0, Vec3(1, 2, 3), 1), 0);
+  CHECK_FALSE(out.estimates.back().initialised);
+  CHECK(out.estimates.back().state.isZero());
+  CHECK(out.estimates.back().innovation.size() == 0);
 }
 
 TEST_CASE("a process-noise change through noise() takes effect at the next step even at a fixed T") {
