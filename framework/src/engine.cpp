@@ -18,6 +18,7 @@ struct RunRecord {
   std::vector<std::unique_ptr<RunResult>> results;  // by node
   Diagnostics diagnostics;
   std::uint64_t source_items = 0;
+  std::uint64_t measurements_processed = 0;
 };
 
 // One run on one instance: the generator with the earliest next item goes first; ties go to
@@ -75,6 +76,9 @@ Outcome run_graph(const Graph& g, const PluginRegistry& registry, const RunOptio
     out.nodes[i].type = g.nodes[i].config.type;
   }
 
+  for (const auto& n : g.nodes)
+    if (n.type->decl.kind == ComponentKind::Filter) ++out.filters;
+
   // The aggregating instance is built first so construction errors surface before any thread starts.
   GraphInstance aggregate = instantiate(g, registry);
 
@@ -86,6 +90,7 @@ Outcome run_graph(const Graph& g, const PluginRegistry& registry, const RunOptio
   std::mutex merge_mutex;
   auto merge_one = [&](std::uint64_t r, RunRecord& rec) {
     out.source_items += rec.source_items;
+    out.measurements_processed += rec.measurements_processed;
     for (size_t i = 0; i < N; ++i)
       if (rec.results[i]) aggregate.components[i]->merge(*rec.results[i]);
     for (const auto& s : rec.diagnostics.skips) {
@@ -112,6 +117,9 @@ Outcome run_graph(const Graph& g, const PluginRegistry& registry, const RunOptio
   auto worker = [&]() {
     try {
       GraphInstance inst = instantiate(g, registry);
+      std::vector<Filter*> filters;
+      for (auto& c : inst.components)
+        if (auto* f = dynamic_cast<Filter*>(c.get())) filters.push_back(f);
       for (;;) {
         const std::uint64_t run = next_run.fetch_add(1);
         if (run >= runs || failed.load()) break;
@@ -119,7 +127,9 @@ Outcome run_graph(const Graph& g, const PluginRegistry& registry, const RunOptio
         try {
           for (size_t i = 0; i < N; ++i)
             inst.components[i]->start_run({run, derive_seed(opt.seed, run, g.nodes[i].config.id), &rec.diagnostics});
+          for (Filter* f : filters) f->take_processed();  // a failed earlier run may have left counts
           rec.source_items = drive(inst);
+          for (Filter* f : filters) rec.measurements_processed += f->take_processed();
           rec.results.resize(N);
           for (size_t i = 0; i < N; ++i) rec.results[i] = inst.components[i]->end_run();
         } catch (const ConfigError&) {

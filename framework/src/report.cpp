@@ -132,8 +132,14 @@ void print_summary(std::ostream& os, const Graph& g, const Outcome& out, unsigne
   os << "pipeline " << c.name;
   if (!c.description.empty()) os << ": " << c.description;
   os << "\n  " << out.runs << (out.runs == 1 ? " run" : " runs") << ", " << threads
-     << (threads == 1 ? " thread" : " threads") << ", seed " << c.seed << "; " << out.source_items
-     << " source items in " << fmt(out.seconds) << " s";
+     << (threads == 1 ? " thread" : " threads") << ", seed " << c.seed << "; " << fmt(out.seconds) << " s\n";
+  if (out.filters > 0) {
+    os << "  measurements processed: " << out.measurements_processed << " by " << out.filters
+       << (out.filters == 1 ? " filter" : " filters");
+    if (out.seconds > 0) os << " (" << fmt(std::round(out.measurements_processed / out.seconds)) << " measurements/s)";
+    os << "\n";
+  }
+  os << "  source items: " << out.source_items;
   if (out.seconds > 0) os << " (" << fmt(std::round(out.source_items / out.seconds)) << " items/s)";
   os << "\n";
   for (const auto& n : out.nodes) {

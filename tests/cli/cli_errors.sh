@@ -34,6 +34,9 @@ YAML
 
 base > "$TMP/ok.yaml"
 expect_run "valid pipeline validates" 0 "ok" -- "$TF" validate "$TMP/ok.yaml"
+# 5 s at 10 Hz, both ends included: 51 measurements, each gives the filter one estimate.
+expect_run "the summary counts measurements processed and their rate" 0 "measurements processed: 51 by 1 filter \([0-9.e+]+ measurements/s\)" \
+  -- "$TF" run "$TMP/ok.yaml" --out "$TMP/out"
 
 base | sed 's/type: filter.kalman/type: filter.kalmn/' > "$TMP/unknown_type.yaml"
 expect_run "unknown type" 2 "unknown_type.yaml:18:11: node 'kf': unknown type 'filter.kalmn' \(did you mean 'filter.kalman'\?\). Available: .*sink.metrics" \

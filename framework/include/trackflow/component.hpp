@@ -163,6 +163,12 @@ class BOOST_SYMBOL_VISIBLE Filter : public Component {
   void set_quality(int channel, int grade) {
     if (channel >= 0 && channel < 3) quality_[channel] = grade;
   }
+  // Engine side: measurements this filter has published an estimate for since the last call.
+  std::uint64_t take_processed() {
+    const std::uint64_t n = processed_;
+    processed_ = 0;
+    return n;
+  }
   // Engine side: returns false when the filter already has kMaxAdapters adapters.
   bool attach(Adapter* a) {
     if (adapter_count_ >= kMaxAdapters) return false;
@@ -177,6 +183,7 @@ class BOOST_SYMBOL_VISIBLE Filter : public Component {
   // Stamps the adapters' grades on `e`, lets adapters see the result, then sends it downstream.
   void publish(const Measurement& m, Estimate& e) {
     for (int c = 0; c < 3; ++c) e.quality[c] = quality_[c];
+    ++processed_;
     for (int i = 0; i < adapter_count_; ++i) adapters_[i]->after_update(m, e, *this);
     out.emit(e);
   }
@@ -185,6 +192,7 @@ class BOOST_SYMBOL_VISIBLE Filter : public Component {
   Adapter* adapters_[kMaxAdapters] = {};
   int adapter_count_ = 0;
   int quality_[3] = {-1, -1, -1};
+  std::uint64_t processed_ = 0;
 };
 
 inline void Outputs::emit(const Truth& t) const {

@@ -32,6 +32,8 @@ struct Outcome {
   std::vector<std::string> warnings;
   std::uint64_t runs = 0;
   std::uint64_t source_items = 0;  // items emitted by generators, all runs
+  std::uint64_t measurements_processed = 0;  // measurements the filters published estimates for
+  int filters = 0;
   double seconds = 0.0;            // wall time of the runs (not set-up, not reporting)
   const NodeOutcome* find(const std::string& id) const;
 };
