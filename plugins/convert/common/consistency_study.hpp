@@ -97,20 +97,8 @@ class ErrorAccumulator final : public Component {
 
 using ComponentFactory = std::function<std::shared_ptr<Component>(const std::string& type)>;
 
-// Feeds the same `draws` noisy measurements of the fixed truth (Rng seeded with `seed`) through
-// every converter in `types`, so the rows are paired comparisons.
-inline std::vector<StudyRow> run_study(const ComponentFactory& make, const std::vector<std::string>& types,
-                                       const StudyGeometry& g, std::uint64_t draws, std::uint64_t seed) {
-  const Vec3 truth = g.sensor_position + spherical_to_enu(g.range, g.azimuth, g.elevation, g.convention);
-  std::vector<std::shared_ptr<Component>> converters;
-  std::vector<std::unique_ptr<ErrorAccumulator>> sinks;
-  std::vector<Link> links(types.size());
-  for (std::size_t i = 0; i < types.size(); ++i) {
-    converters.push_back(make(types[i]));
-    sinks.push_back(std::make_unique<ErrorAccumulator>(truth));
-    links[i] = {sinks[i].get(), 0, 0xFF};
-    converters[i]->out.connect(&links[i], 1);
-  }
+// The study's measurement template: spherical, the geometry's sensor and covariance.
+inline Measurement study_measurement(const StudyGeometry& g) {
   Measurement m;
   m.frame = Frame::Spherical;
   m.azimuth = g.convention;
@@ -119,15 +107,50 @@ inline std::vector<StudyRow> run_study(const ComponentFactory& make, const std::
   m.covariance = MeasCov::Zero(3, 3);
   m.covariance.diagonal() << g.sigma_range * g.sigma_range, g.sigma_azimuth * g.sigma_azimuth,
       g.sigma_elevation * g.sigma_elevation;
+  return m;
+}
+
+// One noisy look at the fixed truth; the draw order (r, az, el) fixes the sequence for a seed.
+inline void draw_measurement(Measurement& m, const StudyGeometry& g, Rng& rng) {
+  m.value << g.range + g.sigma_range * rng.normal(), wrap_angle(g.azimuth + g.sigma_azimuth * rng.normal()),
+      g.elevation + g.sigma_elevation * rng.normal();
+}
+
+// Each converter of `types` wired to its own accumulator of errors against `truth`.
+template <class Accumulator>
+struct ConverterBench {
+  std::vector<std::shared_ptr<Component>> converters;
+  std::vector<std::unique_ptr<Accumulator>> sinks;
+  std::vector<Link> links;
+  template <class Factory>
+  ConverterBench(const Factory& make, const std::vector<std::string>& types, const Vec3& truth) : links(types.size()) {
+    for (std::size_t i = 0; i < types.size(); ++i) {
+      converters.push_back(make(types[i]));
+      sinks.push_back(std::make_unique<Accumulator>(truth));
+      links[i] = {sinks[i].get(), 0, 0xFF};
+      converters[i]->out.connect(&links[i], 1);
+    }
+  }
+  void feed(const Measurement& m) {
+    for (auto& c : converters) c->on_measurement(m, 0);
+  }
+};
+
+// Feeds the same `draws` noisy measurements of the fixed truth (Rng seeded with `seed`) through
+// every converter in `types`, so the rows are paired comparisons.
+inline std::vector<StudyRow> run_study(const ComponentFactory& make, const std::vector<std::string>& types,
+                                       const StudyGeometry& g, std::uint64_t draws, std::uint64_t seed) {
+  const Vec3 truth = g.sensor_position + spherical_to_enu(g.range, g.azimuth, g.elevation, g.convention);
+  ConverterBench<ErrorAccumulator> bench(make, types, truth);
+  Measurement m = study_measurement(g);
   Rng rng(seed);
   for (std::uint64_t k = 0; k < draws; ++k) {
     m.time = static_cast<double>(k);
-    m.value << g.range + g.sigma_range * rng.normal(), wrap_angle(g.azimuth + g.sigma_azimuth * rng.normal()),
-        g.elevation + g.sigma_elevation * rng.normal();
-    for (auto& c : converters) c->on_measurement(m, 0);
+    draw_measurement(m, g, rng);
+    bench.feed(m);
   }
   std::vector<StudyRow> rows;
-  for (std::size_t i = 0; i < types.size(); ++i) rows.push_back(sinks[i]->row(types[i], g.name));
+  for (std::size_t i = 0; i < types.size(); ++i) rows.push_back(bench.sinks[i]->row(types[i], g.name));
   return rows;
 }
 

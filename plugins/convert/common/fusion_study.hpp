@@ -67,34 +67,18 @@ struct FusionRow {
 inline FusionRow run_fusion_study(const ComponentFactory& make, const std::vector<std::string>& types,
                                   const StudyGeometry& g, int fused, std::uint64_t trials, std::uint64_t seed) {
   const Vec3 truth = g.sensor_position + spherical_to_enu(g.range, g.azimuth, g.elevation, g.convention);
-  std::vector<std::shared_ptr<Component>> converters;
-  std::vector<std::unique_ptr<FusionAccumulator>> sinks;
-  std::vector<Link> links(types.size());
-  for (std::size_t i = 0; i < types.size(); ++i) {
-    converters.push_back(make(types[i]));
-    sinks.push_back(std::make_unique<FusionAccumulator>(truth));
-    links[i] = {sinks[i].get(), 0, 0xFF};
-    converters[i]->out.connect(&links[i], 1);
-  }
-  Measurement m;
-  m.frame = Frame::Spherical;
-  m.azimuth = g.convention;
-  m.sensor_position = g.sensor_position;
-  m.value.resize(3);
-  m.covariance = MeasCov::Zero(3, 3);
-  m.covariance.diagonal() << g.sigma_range * g.sigma_range, g.sigma_azimuth * g.sigma_azimuth,
-      g.sigma_elevation * g.sigma_elevation;
+  ConverterBench<FusionAccumulator> bench(make, types, truth);
+  Measurement m = study_measurement(g);
   Rng rng(seed);
   for (std::uint64_t k = 0; k < trials; ++k) {
     for (int j = 0; j < fused; ++j) {
-      m.value << g.range + g.sigma_range * rng.normal(), wrap_angle(g.azimuth + g.sigma_azimuth * rng.normal()),
-          g.elevation + g.sigma_elevation * rng.normal();
-      for (auto& c : converters) c->on_measurement(m, 0);
+      draw_measurement(m, g, rng);
+      bench.feed(m);
     }
-    for (auto& s : sinks) s->end_trial();
+    for (auto& s : bench.sinks) s->end_trial();
   }
   FusionRow row{g.name, fused, {}, false};
-  for (const auto& s : sinks) {
+  for (const auto& s : bench.sinks) {
     row.nees_per_dim.push_back(s->nees_per_dim());
     row.any_not_positive_definite = row.any_not_positive_definite || s->not_positive_definite() > 0;
   }
