@@ -1,8 +1,13 @@
-// Purpose: tests of sim.trajectory: closed-form CV/CA, exact turns, velocity changes, sample times, record validation.
+// Purpose: tests of sim.trajectory: closed-form CV/CA, exact turns, velocity changes, sample times, record validation, process noise.
 #include <catch2/catch.hpp>
 
+#include "flight_plan.hpp"
+#include "launch_profile.hpp"
 #include "plugin_fixture.hpp"
 
+#include <trackflow/rng.hpp>
+
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <numbers>
@@ -12,11 +17,11 @@ using namespace trackflow;
 
 namespace {
 
-std::vector<Truth> fly(const std::string& yaml) {
+std::vector<Truth> fly(const std::string& yaml, std::uint64_t seed = 1, std::uint64_t run = 0) {
   auto gen = test::make("sim.trajectory", yaml);
   test::Collector out;
   out.attach_to(*gen);
-  test::drain(*gen);
+  test::drain(*gen, seed, run);
   return out.truths;
 }
 
@@ -288,4 +293,166 @@ TEST_CASE("keeping the direction of a zero or vertical velocity is refused - a v
   const auto up = fly(still + "  - {type: velocity_change, speed: 100, climb: 90 deg}\n");
   REQUIRE(up.size() == 1);
   CHECK((up[0].velocity - Vec3(0, 0, 100)).norm() < 1e-9);
+}
+
+namespace {
+
+// A manoeuvring flight: every segment kind, near the origin so that deviations of a few mm are
+// not lost to rounding of the position.
+// Flush left, so that a parameter can be appended to it.
+const std::string kManoeuvres = R"(rate: 10 Hz
+initial_position: [10 m, -20 m, 5 m]
+initial_velocity: [30 m/s, 0, 1 m/s]
+segments:
+  - {type: constant_velocity, duration: 2 s}
+  - {type: turn, turn_rate: 10 deg/s, duration: 3 s}
+  - {type: constant_acceleration, acceleration: [-2, 1, 0], duration: 2 s}
+  - {type: velocity_change, speed: 20 m/s, heading: 200 deg}
+  - {type: constant_velocity, duration: 3 s}
+)";
+const std::string kLaunch = "rate: 2 Hz\nprofile: kslv1\npad_position: [0, 50 km, 0]\nlaunch_azimuth: 120 deg\n"
+                            "earth: spherical\nprofile_duration: 60 s\n";
+
+// The profile without the plugin's sampling loop: the piece in force at t, evaluated in closed form.
+sim::Kinematics profile_at(const std::vector<sim::MotionPiece>& pieces, double t) {
+  size_t i = 0;
+  while (i + 1 < pieces.size() && pieces[i + 1].start <= t + 1e-9) ++i;
+  return sim::evaluate(pieces[i], t);
+}
+
+}  // namespace
+
+TEST_CASE("process noise off: output is the deterministic profile") {
+  struct Case {
+    const std::string* yaml;
+    bool launch;
+  };
+  for (const Case c : {Case{&kManoeuvres, false}, Case{&kLaunch, true}}) {
+    const Params p = test::params_for("sim.trajectory", *c.yaml);
+    const auto pieces = c.launch ? sim::build_launch_plan(p) : sim::build_flight_plan(p);
+    for (const char* off : {"", "process_noise_q: 0 m2/s3\n", "process_noise_q_enu: [0, 0, 0]\n"}) {
+      INFO(*c.yaml << off);
+      for (std::uint64_t seed : {1u, 99u}) {
+        const auto truths = fly(*c.yaml + off, seed, seed);
+        REQUIRE(truths.size() > 10);
+        for (const Truth& t : truths) {
+          const sim::Kinematics k = profile_at(pieces, t.time);
+          // Bitwise: an exact comparison, not a tolerance.
+          CHECK((t.position.array() == k.position.array()).all());
+          CHECK((t.velocity.array() == k.velocity.array()).all());
+          CHECK((t.acceleration.array() == k.acceleration.array()).all());
+        }
+      }
+    }
+  }
+}
+
+TEST_CASE("process noise increments have the CV model covariance") {
+  // Per axis the deviation d = truth - profile obeys d' = F d + w with F = [[1, T], [0, 1]] and
+  // w ~ N(0, q Q1), Q1 = [[T³/3, T²/2], [T²/2, T]]. Over R runs and K steps the N = R K vectors
+  // w (6 components: p and v of east, north, up) are independent with mean zero, so the moment
+  // estimate S_ij = Σ w_i w_j / N is unbiased with Var S_ij = (Σ_ii Σ_jj + Σ_ij²) / N (Isserlis:
+  // E[w_i² w_j²] = Σ_ii Σ_jj + 2 Σ_ij²). S is a mean of N iid terms, so nearly normal at N = 40000;
+  // |S_ij - Σ_ij| < 5 sd has a false-alarm chance below 1e-6 per entry (the seed is fixed, so the
+  // test is deterministic; the bound is what makes a wrong factor such as T² or T³/2 fail:
+  // those are off by 25 % or more, against 5 sd = 5 √(2/N) = 3.5 % on a diagonal entry).
+  const Vec3 q(4.0, 1.0, 0.25);
+  const double T = 0.1;
+  const int R = 400;
+  const std::string base = "rate: 10 Hz\ninitial_position: [1 m, 2 m, 3 m]\ninitial_velocity: [5 m/s, -5 m/s, 0]\n"
+                           "segments: [{type: constant_velocity, duration: 10 s}]\n";
+  const auto profile = fly(base);
+  const int K = static_cast<int>(profile.size()) - 1;
+  REQUIRE(K == 100);
+  Eigen::Matrix<double, 6, 6> sum = Eigen::Matrix<double, 6, 6>::Zero();
+  Eigen::Matrix<double, 6, 6> end_sum = Eigen::Matrix<double, 6, 6>::Zero();
+  auto deviation = [&](const Truth& noisy, const Truth& clean) {
+    Eigen::Matrix<double, 6, 1> d;
+    for (int a = 0; a < 3; ++a) {
+      d(2 * a) = noisy.position[a] - clean.position[a];
+      d(2 * a + 1) = noisy.velocity[a] - clean.velocity[a];
+    }
+    return d;
+  };
+  double worst_accel = 0.0;
+  for (int r = 0; r < R; ++r) {
+    const auto truths = fly(base + "process_noise_q_enu: [4, 1, 0.25]\n", derive_seed(11, r, "truth"), r);
+    REQUIRE(truths.size() == profile.size());
+    CHECK(deviation(truths[0], profile[0]).norm() == 0.0);  // the run starts on the profile
+    for (int k = 0; k < K; ++k) {
+      const auto d0 = deviation(truths[k], profile[k]), d1 = deviation(truths[k + 1], profile[k + 1]);
+      Eigen::Matrix<double, 6, 1> w;  // d1 - F d0
+      for (int a = 0; a < 3; ++a) {
+        w(2 * a) = d1(2 * a) - d0(2 * a) - T * d0(2 * a + 1);
+        w(2 * a + 1) = d1(2 * a + 1) - d0(2 * a + 1);
+      }
+      sum += w * w.transpose();
+      // The reported acceleration is the profile's (zero) plus the step's mean white acceleration.
+      for (int a = 0; a < 3; ++a)
+        worst_accel = std::max(worst_accel, std::abs(truths[k + 1].acceleration[a] - w(2 * a + 1) / T));
+    }
+    const auto d = deviation(truths.back(), profile.back());
+    end_sum += d * d.transpose();
+  }
+  CHECK(worst_accel < 1e-9);
+  // Expected covariances: of one increment (period T) and of the deviation at the end (t = K T,
+  // the same model integrated from zero: q [[t³/3, t²/2], [t²/2, t]]).
+  auto model = [&](double t) {
+    Eigen::Matrix<double, 6, 6> m = Eigen::Matrix<double, 6, 6>::Zero();
+    for (int a = 0; a < 3; ++a) {
+      m(2 * a, 2 * a) = q[a] * t * t * t / 3;
+      m(2 * a, 2 * a + 1) = m(2 * a + 1, 2 * a) = q[a] * t * t / 2;
+      m(2 * a + 1, 2 * a + 1) = q[a] * t;
+    }
+    return m;
+  };
+  auto check_cov = [](const Eigen::Matrix<double, 6, 6>& S, const Eigen::Matrix<double, 6, 6>& E, double n) {
+    for (int i = 0; i < 6; ++i)
+      for (int j = i; j < 6; ++j) {
+        const double sd = std::sqrt((E(i, i) * E(j, j) + E(i, j) * E(i, j)) / n);
+        INFO("entry " << i << " " << j << ": " << S(i, j) << " expected " << E(i, j) << " sd " << sd);
+        CHECK(std::abs(S(i, j) - E(i, j)) < 5 * sd);
+      }
+  };
+  const double N = static_cast<double>(R) * K;
+  check_cov(sum / N, model(T), N);
+  check_cov(end_sum / R, model(K * T), R);  // R = 400: 5 sd is 35 % on a diagonal entry
+}
+
+TEST_CASE("process noise: same seed same path - another run another path") {
+  const std::string yaml = kManoeuvres + "process_noise_q: 2 m2/s3\n";
+  auto gen = test::make("sim.trajectory", yaml, "truth");
+  auto run = [&](std::uint64_t r) {
+    test::Collector out;
+    out.attach_to(*gen);
+    test::drain(*gen, derive_seed(42, r, "truth"), r);
+    return out.truths;
+  };
+  const auto a = run(0), b = run(1), again = run(0);
+  const auto fresh = fly(yaml, derive_seed(42, 0, "truth"), 0);
+  const Params p = test::params_for("sim.trajectory", kManoeuvres);
+  const auto pieces = sim::build_flight_plan(p);
+  REQUIRE(a.size() == b.size());
+  REQUIRE(a.size() == again.size());
+  REQUIRE(a.size() == fresh.size());
+  size_t differ = 0;
+  for (size_t k = 0; k < a.size(); ++k) {
+    CHECK((a[k].position.array() == again[k].position.array()).all());  // start_run starts the stream over
+    CHECK((a[k].velocity.array() == fresh[k].velocity.array()).all());  // and depends on nothing but the seed
+    CHECK((a[k].acceleration.array() == fresh[k].acceleration.array()).all());
+    if ((a[k].position - b[k].position).norm() > 1e-6) ++differ;
+    if (k > 0) CHECK((a[k].position - profile_at(pieces, a[k].time).position).norm() > 0.0);
+  }
+  CHECK(differ == a.size() - 1);  // every sample but the first, which is on the profile in both
+  CHECK((a[0].position - b[0].position).norm() == 0.0);
+}
+
+TEST_CASE("process noise parameters are checked") {
+  const std::string head = "initial_position: [0, 0, 0]\nsegments: [{type: constant_velocity, duration: 1 s}]\n";
+  CHECK_THAT(config_error(head + "process_noise_q: 1\nprocess_noise_q_enu: [1, 1, 1]\n"),
+             Catch::Matchers::Contains("'process_noise_q_enu'"));
+  CHECK_THAT(config_error(head + "process_noise_q: -1\n"), Catch::Matchers::Contains("process_noise_q"));
+  CHECK_THAT(config_error(head + "process_noise_q_enu: [1, -1, 1]\n"), Catch::Matchers::Contains("process_noise_q_enu"));
+  CHECK_THAT(config_error(head + "process_noise_q_enu: [1, 1]\n"), Catch::Matchers::Contains("process_noise_q_enu"));
+  CHECK(config_error(head + "process_noise_q: 1 m2/s3\n").empty());
 }

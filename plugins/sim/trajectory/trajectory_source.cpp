@@ -1,6 +1,7 @@
-// Purpose: sim.trajectory — a truth generator that flies CV / CA / turn / velocity-change segments or a launch profile exactly.
+// Purpose: sim.trajectory — a truth generator that flies CV / CA / turn / velocity-change segments or a launch profile exactly, optionally with white-noise acceleration.
 #include "flight_plan.hpp"
 #include "launch_profile.hpp"
+#include "process_noise.hpp"
 
 #include <trackflow/plugin.hpp>
 
@@ -22,16 +23,18 @@ class TrajectorySource final : public Generator {
   explicit TrajectorySource(const Params& params)
       : pieces_(params.text("profile") == "none" ? sim::build_flight_plan(params) : sim::build_launch_plan(params)),
         rate_(params.real("rate")),
-        start_(params.real("start_time")) {
+        start_(params.real("start_time")),
+        noise_(sim::process_noise_q(params), 1.0 / rate_) {
     truth_.target = static_cast<std::uint32_t>(params.integer("target"));
     const double span = (pieces_.back().end - start_) * rate_;
     if (span > 1e10) throw params.error("rate", "gives more than 1e10 samples over the trajectory; lower it");
     sample_count_ = static_cast<long long>(std::floor(span + kTimeTolerance * rate_)) + 1;
   }
 
-  void start_run(const RunContext&) override {
+  void start_run(const RunContext& ctx) override {
     next_sample_ = 0;
     piece_ = 0;
+    if (noise_.enabled()) noise_.reset(ctx.seed);
   }
 
   double next_time() const override {
@@ -39,6 +42,7 @@ class TrajectorySource final : public Generator {
   }
 
   void emit_next() override {
+    const bool first = next_sample_ == 0;
     const double t = sample_time(next_sample_++);
     // Samples only move forward, so the current piece only moves forward too.
     while (piece_ + 1 < pieces_.size() && pieces_[piece_ + 1].start <= t + kTimeTolerance) ++piece_;
@@ -47,6 +51,13 @@ class TrajectorySource final : public Generator {
     truth_.position = k.position;
     truth_.velocity = k.velocity;
     truth_.acceleration = k.acceleration;
+    // Skipped entirely when off, so the profile's values (signed zeros included) pass unchanged.
+    if (noise_.enabled()) {
+      if (!first) noise_.step();
+      truth_.position += noise_.position();
+      truth_.velocity += noise_.velocity();
+      truth_.acceleration += noise_.acceleration();
+    }
     out.emit(truth_);
   }
 
@@ -59,6 +70,7 @@ class TrajectorySource final : public Generator {
   long long sample_count_ = 0;
   long long next_sample_ = 0;
   size_t piece_ = 0;
+  sim::WhiteAccelerationNoise noise_;
   Truth truth_;
 };
 
@@ -86,7 +98,7 @@ void register_components(Registrar& r) {
   d.type = "sim.trajectory";
   d.kind = ComponentKind::Source;
   d.summary = "Simulated target truth (ENU) flying constant-velocity, constant-acceleration, turn and velocity-change "
-              "segments, or the KSLV-I launch profile";
+              "segments, or the KSLV-I launch profile, optionally perturbed by white-noise acceleration";
   d.doc = "Each segment is propagated in closed form from where the previous one ended (no numerical integration). "
           "A turn is a horizontal coordinated turn at constant rate that keeps the vertical velocity. A "
           "velocity_change is instantaneous: a sample at its time already shows the new velocity. Truth "
@@ -109,7 +121,19 @@ void register_components(Registrar& r) {
           "it ignores the earth's curvature, which at 2054 km downrange puts the real vehicle about 340 km lower "
           "(below a pad radar's horizon). earth: spherical bends the track over a sphere of radius 6371 km whose "
           "surface passes through the frame's origin: downrange is the great-circle arc, altitude is measured from "
-          "the pad's radius, and the azimuth is the frame's compass direction carried to the pad.";
+          "the pad's radius, and the azimuth is the frame's compass direction carried to the pad.\n"
+          "Process noise (off by default): process_noise_q > 0 (or process_noise_q_enu, one value per ENU axis) adds to "
+          "any of the above a deviation driven by continuous white acceleration of that spectral density, the continuous "
+          "white noise acceleration (CV) model of Bar-Shalom, Li & Kirubarajan 2001 §6.2.2 (eq 6.2.2-12), discretised "
+          "exactly at the sample period T = 1/rate: per axis the deviation [dp, dv] starts at zero at the first sample "
+          "and at each later sample becomes [dp + T dv, dv] + w, w ~ N(0, q [[T³/3, T²/2], [T²/2, T]]), drawn with the "
+          "closed-form Cholesky factor. The deviation accumulates over the run (position and velocity wander off the "
+          "profile like a random walk) and is added to the profile's position and velocity; the reported acceleration "
+          "is the profile's plus the mean white acceleration over the step just ended, Δdv/T (zero at the first "
+          "sample). A CV filter.kalman with q equal to process_noise_q is then the matched model on a straight "
+          "profile. Random draws: per sample after the first, two standard normals per axis (east, north, up), from "
+          "the run's seed of this node (independent of every other node's stream, identical for any --threads); with "
+          "q = 0 on every axis nothing is drawn and the output is exactly the profile.";
   d.params = {
       ParamSpec::real("rate", dim::frequency, "sample rate of the truth").def("10 Hz").positive(),
       ParamSpec::real("start_time", dim::time, "time of the first sample and of the start of the first segment").def("0 s"),
@@ -123,6 +147,13 @@ void register_components(Registrar& r) {
       ParamSpec::real("launch_azimuth", dim::angle, "profile: compass direction of the downrange track, from north clockwise"),
       ParamSpec::choice("earth", {"flat", "spherical"}, "profile: flat ground line (paper 000) or a spherical earth").def("flat"),
       ParamSpec::real("profile_duration", dim::time, "profile: fly only the first part of it (default: the whole table)").positive(),
+      ParamSpec::real("process_noise_q", dim::accel_psd,
+                      "spectral density of white acceleration added to the truth, every ENU axis (0: off)")
+          .def("0 m2/s3")
+          .at_least(0),
+      ParamSpec::real_list("process_noise_q_enu", dim::accel_psd,
+                           "instead of process_noise_q: one spectral density per axis [east, north, up]", 3)
+          .at_least(0),
   };
   d.accepts = 0;
   d.min_inputs = 0;
