@@ -11,7 +11,7 @@ namespace {
 std::vector<ParamSpec> specs() {
   return {ParamSpec::real("sigma_range", dim::length, "range noise").def("10 m").at_least(0),
           ParamSpec::real("rate", dim::frequency, "sample rate").req().positive(),
-          ParamSpec::choice("mode", {"skin", "beacon"}, "track mode").def("skin"),
+          ParamSpec::choice_words("mode", {"skin", "beacon"}, "track mode").def("skin"),
           ParamSpec::real_list("position", dim::length, "sensor position", 3).def("[0, 0, 0]")};
 }
 ConfigError validate_error(const std::string& yaml) {
@@ -33,7 +33,7 @@ TEST_CASE("valid parameters come out in SI, defaults filled") {
   CHECK(p.real("sigma_range") == 10.0);
   CHECK_FALSE(p.given("sigma_range"));
   CHECK(p.given("rate"));
-  CHECK(p.text("mode") == "skin");
+  CHECK(p.choice_word("mode") == "skin");
   CHECK(p.vec3("position")(0) == 1000.0);
 }
 

@@ -14,6 +14,8 @@ const char* to_string(ItemKind k) {
   return "?";
 }
 
+const char* to_string(Frame f) { return f == Frame::Spherical ? "spherical" : "cartesian"; }
+
 const char* to_string(ComponentKind k) {
   switch (k) {
     case ComponentKind::Source: return "source";
@@ -35,6 +37,5 @@ void Component::on_estimate(const Estimate&, int) { throw std::logic_error("comp
 
 void Adapter::before_update(const Measurement&, Filter&) {}
 void Adapter::after_update(const Measurement&, const Estimate&, Filter&) {}
-std::string Adapter::incompatibility(Filter&) { return {}; }
 
 }  // namespace trackflow

@@ -125,6 +125,9 @@ Outcome run_graph(const Graph& g, const PluginRegistry& registry, const RunOptio
         if (run >= runs || failed.load()) break;
         RunRecord rec;
         try {
+          // The engine, not each filter's discipline, puts back what adapters tuned in the previous
+          // run on this instance: otherwise results would depend on which thread ran which run.
+          for (Filter* f : filters) f->reset_adapted_state();
           for (size_t i = 0; i < N; ++i)
             inst.components[i]->start_run({run, derive_seed(opt.seed, run, g.nodes[i].config.id), &rec.diagnostics});
           for (Filter* f : filters) f->take_processed();  // a failed earlier run may have left counts

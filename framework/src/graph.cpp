@@ -156,6 +156,52 @@ Graph build_graph(PipelineConfig cfg, const PluginRegistry& registry) {
   return g;
 }
 
+namespace {
+
+std::string frames(FrameMask m) {
+  std::vector<std::string> f;
+  for (Frame i : {Frame::Spherical, Frame::Cartesian})
+    if (m & mask(i)) f.push_back(to_string(i));
+  return f.empty() ? "no" : join(f, "/");
+}
+
+std::vector<std::string> converter_types(const PluginRegistry& registry) {
+  std::vector<std::string> out;
+  for (const auto& t : registry.types())
+    if (t.decl.kind == ComponentKind::Converter) out.push_back(t.decl.type);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+// A measurement wire whose frames do not meet is refused before anything runs.
+void check_frames(const Graph& g, const GraphInstance& inst, const PluginRegistry& registry) {
+  for (size_t i = 0; i < g.nodes.size(); ++i) {
+    const GraphNode& n = g.nodes[i];
+    const ComponentDecl& d = n.type->decl;
+    for (size_t k = 0; k < n.inputs.size(); ++k) {
+      if (!(n.input_kinds[k] & mask(ItemKind::Measurement))) continue;
+      const GraphNode& up = g.nodes[n.inputs[k]];
+      const FrameMask produced = up.type->decl.produces_frames & inst.components[n.inputs[k]]->produced_frames();
+      if (produced & d.accepts_frames) continue;
+      std::string hint;
+      if ((d.accepts_frames & mask(Frame::Cartesian)) && (produced & mask(Frame::Spherical)))
+        hint = "; insert a converter between them (" + join(converter_types(registry)) + ")";
+      else if (d.accepts_frames & mask(Frame::Spherical))
+        hint = "; wire it to the radar's spherical output instead";
+      throw ConfigError("input '" + up.config.id + "' (" + up.config.type + ") produces " + frames(produced) +
+                            " measurements, but " + n.config.type + " takes " + frames(d.accepts_frames) +
+                            " measurements" + hint,
+                        n.config.input_locs[k], n.config.id);
+    }
+  }
+}
+
+std::string qualified(const std::string& adapter, const std::vector<std::string>& names, size_t i) {
+  return adapter + "." + names[i];
+}
+
+}  // namespace
+
 GraphInstance instantiate(const Graph& g, const PluginRegistry& registry) {
   GraphInstance inst;
   const size_t N = g.nodes.size();
@@ -172,11 +218,40 @@ GraphInstance instantiate(const Graph& g, const PluginRegistry& registry) {
       throw ConfigError(e.what(), n.config.loc, n.config.id);
     }
   }
+  check_frames(g, inst, registry);
+
+  // Adapters first: what they need is checked against the filter, and the filter's annotation
+  // names are known before its consumers learn their inputs.
+  std::vector<std::vector<std::string>> annotations(N);
+  for (size_t i = 0; i < N; ++i) {
+    const GraphNode& n = g.nodes[i];
+    if (n.attach_to < 0) continue;
+    auto* adapter = dynamic_cast<Adapter*>(inst.components[i].get());
+    auto* filter = dynamic_cast<Filter*>(inst.components[n.attach_to].get());
+    const std::string& fid = g.nodes[n.attach_to].config.id;
+    if (!adapter || !filter)
+      throw ConfigError("cannot attach: " + n.config.type + " is not an Adapter or its target is not a Filter",
+                        n.config.attach_loc, n.config.id);
+    const NoiseNeeds needs = adapter->needs();
+    if (std::string why = noise_mismatch(needs, filter->noise(), filter->has_covariance_access()); !why.empty())
+      throw ConfigError("cannot attach adapter '" + n.config.id + "' (" + n.config.type + ") to filter '" + fid +
+                            "' (" + g.nodes[n.attach_to].config.type + "): " + why,
+                        n.config.attach_loc, n.config.id);
+    const std::vector<std::string> names = adapter->annotation_names();
+    if (!filter->attach(adapter, static_cast<int>(names.size())))
+      throw ConfigError("too many adapters or annotations on '" + fid + "' (at most " +
+                            std::to_string(Filter::kMaxAdapters) + " adapters and " + std::to_string(kMaxAnnotations) +
+                            " annotations per filter)",
+                        n.config.attach_loc, n.config.id);
+    for (size_t k = 0; k < names.size(); ++k) annotations[n.attach_to].push_back(qualified(n.config.id, names, k));
+  }
+
   for (size_t i = 0; i < N; ++i) {
     const GraphNode& n = g.nodes[i];
     std::vector<InputInfo> infos;
     for (size_t k = 0; k < n.inputs.size(); ++k)
-      infos.push_back({g.nodes[n.inputs[k]].config.id, g.nodes[n.inputs[k]].config.type, n.input_kinds[k]});
+      infos.push_back({g.nodes[n.inputs[k]].config.id, g.nodes[n.inputs[k]].config.type, n.input_kinds[k],
+                       annotations[n.inputs[k]]});
     try {
       inst.components[i]->set_inputs(infos);
     } catch (const ConfigError& e) {
@@ -190,22 +265,12 @@ GraphInstance instantiate(const Graph& g, const PluginRegistry& registry) {
                           n.config.loc, n.config.id);
       inst.roots.push_back(static_cast<int>(i));
     }
-    if (n.attach_to >= 0) {
-      auto* adapter = dynamic_cast<Adapter*>(inst.components[i].get());
-      auto* filter = dynamic_cast<Filter*>(inst.components[n.attach_to].get());
-      if (!adapter || !filter)
-        throw ConfigError("cannot attach: " + n.config.type + " is not an Adapter or its target is not a Filter",
-                          n.config.attach_loc, n.config.id);
-      if (std::string why = adapter->incompatibility(*filter); !why.empty())
-        throw ConfigError("cannot attach to '" + g.nodes[n.attach_to].config.id + "': " + why, n.config.attach_loc,
-                          n.config.id);
-      if (!filter->attach(adapter))
-        throw ConfigError("too many adapters on '" + g.nodes[n.attach_to].config.id + "'", n.config.attach_loc,
-                          n.config.id);
-    }
   }
   for (size_t i = 0; i < N; ++i)
     inst.components[i]->out.connect(inst.links[i].data(), static_cast<int>(inst.links[i].size()));
+  // What adapters tune is put back to this at the start of every run (engine).
+  for (auto& c : inst.components)
+    if (auto* f = dynamic_cast<Filter*>(c.get())) f->save_configured_noise();
   return inst;
 }
 

@@ -40,8 +40,9 @@ ParamSpec ParamSpec::boolean(std::string name, std::string doc) {
 ParamSpec ParamSpec::string(std::string name, std::string doc) {
   return make(std::move(name), ParamType::String, std::move(doc));
 }
-ParamSpec ParamSpec::choice(std::string name, std::vector<std::string> choices, std::string doc) {
+ParamSpec ParamSpec::choice_words(std::string name, std::vector<std::string> choices, std::string doc) {
   auto s = make(std::move(name), ParamType::Choice, std::move(doc));
+  for (size_t i = 0; i < choices.size(); ++i) s.choice_values.push_back(static_cast<int>(i));
   s.choices = std::move(choices);
   return s;
 }
@@ -60,9 +61,7 @@ ParamSpec ParamSpec::records(std::string name, std::vector<ParamSpec> fields, st
 const ParamValue& Params::get(std::string_view name, ParamType expected) const {
   for (const auto& [n, v] : values_) {
     if (n != name) continue;
-    const bool ok = v.type == expected ||
-                    (expected == ParamType::String && v.type == ParamType::Choice);
-    if (!ok)
+    if (v.type != expected)
       throw ConfigError("parameter '" + std::string(name) + "' is a " + to_string(v.type) +
                             ", read as a " + to_string(expected) + " (plugin bug)",
                         v.where, node_);
@@ -76,6 +75,7 @@ double Params::real(std::string_view n) const { return get(n, ParamType::Real).r
 long long Params::integer(std::string_view n) const { return get(n, ParamType::Integer).integer; }
 bool Params::boolean(std::string_view n) const { return get(n, ParamType::Boolean).boolean; }
 const std::string& Params::text(std::string_view n) const { return get(n, ParamType::String).text; }
+const std::string& Params::choice_word(std::string_view n) const { return get(n, ParamType::Choice).text; }
 const std::vector<double>& Params::reals(std::string_view n) const { return get(n, ParamType::RealList).reals; }
 const std::vector<Params>& Params::records(std::string_view n) const { return get(n, ParamType::Records).records; }
 

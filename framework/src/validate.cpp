@@ -81,14 +81,18 @@ ParamValue parse_value(const ParamSpec& s, const Value& v, const std::string& no
       if (!v.is_scalar()) throw type_error();
       out.text = v.scalar;
       break;
-    case ParamType::Choice:
+    case ParamType::Choice: {
       if (!v.is_scalar()) throw type_error();
-      if (std::find(s.choices.begin(), s.choices.end(), v.scalar) == s.choices.end())
+      const auto it = std::find(s.choices.begin(), s.choices.end(), v.scalar);
+      if (it == s.choices.end())
         throw ConfigError("parameter '" + s.name + "' must be one of " + join(s.choices, ", ") + "; got '" + v.scalar +
                               "'" + did_you_mean(v.scalar, s.choices),
                           v.loc, node);
+      const size_t i = static_cast<size_t>(it - s.choices.begin());
+      out.choice = i < s.choice_values.size() ? s.choice_values[i] : static_cast<int>(i);
       out.text = v.scalar;
       break;
+    }
     case ParamType::RealList: {
       if (v.kind != Value::Kind::List) throw type_error();
       if (s.list_size >= 0 && static_cast<int>(v.items.size()) != s.list_size)

@@ -88,6 +88,19 @@ rc=$?
 [ "$rc" -eq 0 ] || fail "trackflow run exited $rc (expected 0: pipeline runs and its expect: block passes)"
 ok "exit 0, expect checks passed"
 
+step "trackflow run fading_memory.yaml: a third-party adapter that rescales P, attached from YAML"
+"$tf" run "$example/fading_memory.yaml" --plugin-path "$plugin_build" --no-progress --out "$tmp/out-fm" >"$log" 2>&1
+rc=$?
+[ "$rc" -eq 0 ] || fail "trackflow run fading_memory.yaml exited $rc (expected 0: its expect: block passes)"
+grep -q 'covariance_rescales' "$log" || fail "the adapter's summary (covariance_rescales) is missing"
+ok "exit 0: the faded filter's ANEES and RMSE are below the plain filter's"
+# Broken on purpose: alpha = 1 rescales by 1, so the expect block must fail (exit 1).
+"$tf" run "$example/fading_memory.yaml" --plugin-path "$plugin_build" --no-progress --set fading.alpha=1 \
+  --out "$tmp/out-fm1" >"$log" 2>&1
+rc=$?
+[ "$rc" -eq 1 ] || fail "with fading.alpha=1 (no rescale) trackflow run exited $rc (expected 1: a failed check)"
+ok "with alpha = 1 the check fails (exit 1): the pass above comes from the rescale"
+
 step "the same run without --plugin-path fails cleanly"
 "$tf" run "$pipeline" --no-progress --out "$tmp/out-missing" >"$log" 2>&1
 rc=$?

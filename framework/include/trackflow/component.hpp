@@ -1,11 +1,13 @@
-// Purpose: the interfaces a plugin implements: Component, Generator (root source), Filter, Adapter.
+// Purpose: the interfaces a plugin implements: Component, Generator (root source), Filter, Adapter, and the filter–adapter contract.
 #pragma once
 
 #include <trackflow/items.hpp>
+#include <trackflow/noise.hpp>
 
 #include <boost/config.hpp>
 
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -76,6 +78,8 @@ struct InputInfo {
   std::string node;   // upstream node id
   std::string type;   // upstream component type
   ItemMask kinds = 0; // item kinds this input delivers
+  // A filter's input: the names of Estimate::annotations, "<adapter id>.<name>", in order.
+  std::vector<std::string> annotations;
 };
 
 struct FinishContext {
@@ -109,6 +113,9 @@ class BOOST_SYMBOL_VISIBLE Component {
   // Called once after construction with this node's inputs; may throw ConfigError (e.g. a
   // sink that takes at most one estimate stream).
   virtual void set_inputs(const std::vector<InputInfo>&) {}
+  // The measurement frames this instance emits, when its parameters narrow what its type
+  // declares (a recorded log of Cartesian positions); checked against its consumers.
+  virtual FrameMask produced_frames() const { return kAnyFrame; }
   virtual void start_run(const RunContext&) {}
   // Items arriving on input `port` (the position of the source in the node's `inputs:`).
   virtual void on_truth(const Truth&, int port);
@@ -135,65 +142,108 @@ class BOOST_SYMBOL_VISIBLE Generator : public Component {
 
 class Filter;
 
-// Attached to a filter in YAML (`attach_to: <filter id>`); retunes Q and R between steps.
+// Attached to a filter in YAML (`attach_to: <filter id>`); retunes its noise, rescales its state
+// covariance or annotates its estimates between steps. What it touches is declared by needs()
+// and checked against the filter's noise() before anything runs.
 class BOOST_SYMBOL_VISIBLE Adapter : public Component {
  public:
-  // Called before the filter uses `m`, and after it has produced `e` from it.
+  // What this adapter reads and writes (may depend on its parameters).
+  virtual NoiseNeeds needs() const { return {}; }
+  // Names of the values this adapter publishes on every estimate of its filter (see annotate);
+  // sinks see them as "<adapter id>.<name>".
+  virtual std::vector<std::string> annotation_names() const { return {}; }
+  // Called before the filter uses `m` (R already holds the measurement's own covariance), and
+  // after it has produced `e` from it.
   virtual void before_update(const Measurement& m, Filter& f);
   virtual void after_update(const Measurement& m, const Estimate& e, Filter& f);
-  // Checked when the pipeline is built: empty string if this adapter can drive `f`.
-  virtual std::string incompatibility(Filter& f);
-};
 
-// The noise a filter lets adapters read and overwrite. Null members are not exposed.
-struct NoiseHandles {
-  MeasCov* measurement_noise = nullptr;  // R in the filter's measurement space
-  double* process_noise = nullptr;       // intensities q (one per axis or one in all)
-  int process_noise_count = 0;
-  const char* measurement_space = "";     // e.g. "cartesian_position", "spherical"
+  // Engine side: where this adapter's annotations start in the filter's list.
+  void set_first_annotation(int slot) { first_annotation_ = slot; }
+
+ protected:
+  // Sets annotation `i` (index into annotation_names()) on the filter's next estimates; it
+  // stays until changed. NaN: no value.
+  inline void annotate(Filter& f, int i, double value) const;
+
+ private:
+  int first_annotation_ = 0;
 };
 
 class BOOST_SYMBOL_VISIBLE Filter : public Component {
  public:
   static constexpr int kMaxAdapters = 4;
+  // The noise adapters may read and overwrite, with what each number is (noise.hpp).
   virtual NoiseHandles noise() { return {}; }
-  // Per-channel grade (e.g. BEST/NORMAL/WORST of a quality-switching adapter) that the next
-  // published Estimate carries in Estimate::quality; -1 = no grade. Adapters set it in
-  // before_update.
-  void set_quality(int channel, int grade) {
-    if (channel >= 0 && channel < 3) quality_[channel] = grade;
-  }
+  virtual StateLayout state_layout() const { return {}; }
+
+  // State covariance for adapters (fading memory, inflation, re-initialisation). A filter that
+  // returns true from has_covariance_access implements the three below.
+  virtual bool has_covariance_access() const { return false; }
+  // The covariance of the state as published (state_layout order); empty before initialisation.
+  virtual void read_covariance(StateCov& P) const { P.resize(0, 0); }
+  // P <- factor P (factor > 0), whatever the filter's internal representation of P.
+  virtual void scale_covariance(double /*factor*/) {}
+  // Forgets the track: the next measurements initialise it again.
+  virtual void restart_track() {}
+
   // Engine side: measurements this filter has published an estimate for since the last call.
   std::uint64_t take_processed() {
     const std::uint64_t n = processed_;
     processed_ = 0;
     return n;
   }
-  // Engine side: returns false when the filter already has kMaxAdapters adapters.
-  bool attach(Adapter* a) {
-    if (adapter_count_ >= kMaxAdapters) return false;
+  // Engine side: attaches `a` with `annotations` values; false when there is no room.
+  bool attach(Adapter* a, int annotations) {
+    if (adapter_count_ >= kMaxAdapters || annotation_count_ + annotations > kMaxAnnotations) return false;
+    a->set_first_annotation(annotation_count_);
+    annotation_count_ += annotations;
     adapters_[adapter_count_++] = a;
     return true;
   }
+  // Engine side: remembers the process noise as configured (call once, before any run) ...
+  void save_configured_noise() {
+    const ProcessNoiseHandle q = noise().process;
+    configured_count_ = q ? (q.count < kMaxNoiseValues ? q.count : kMaxNoiseValues) : 0;
+    for (int i = 0; i < configured_count_; ++i) configured_[i] = q.values[i];
+  }
+  // ... and puts it back, with no annotation values, at the start of every run, so what an
+  // adapter tuned in one run never leaks into the next (whichever thread runs it).
+  void reset_adapted_state() {
+    const ProcessNoiseHandle q = noise().process;
+    for (int i = 0; i < configured_count_ && q && i < q.count; ++i) q.values[i] = configured_[i];
+    for (double& a : annotation_values_) a = kNoAnnotation;
+  }
+  void set_annotation(int slot, double value) {
+    if (slot >= 0 && slot < annotation_count_) annotation_values_[slot] = value;
+  }
 
  protected:
+  static constexpr double kNoAnnotation = std::numeric_limits<double>::quiet_NaN();
   void before_update(const Measurement& m) {
     for (int i = 0; i < adapter_count_; ++i) adapters_[i]->before_update(m, *this);
   }
-  // Stamps the adapters' grades on `e`, lets adapters see the result, then sends it downstream.
+  // Stamps the adapters' annotations on `e`, lets adapters see the result, then sends it on.
   void publish(const Measurement& m, Estimate& e) {
-    for (int c = 0; c < 3; ++c) e.quality[c] = quality_[c];
+    e.annotation_count = annotation_count_;
+    for (int i = 0; i < annotation_count_; ++i) e.annotations[i] = annotation_values_[i];
     ++processed_;
     for (int i = 0; i < adapter_count_; ++i) adapters_[i]->after_update(m, e, *this);
     out.emit(e);
   }
 
  private:
+  static constexpr int kMaxNoiseValues = 8;
   Adapter* adapters_[kMaxAdapters] = {};
   int adapter_count_ = 0;
-  int quality_[3] = {-1, -1, -1};
+  int annotation_count_ = 0;
+  double annotation_values_[kMaxAnnotations] = {kNoAnnotation, kNoAnnotation, kNoAnnotation, kNoAnnotation,
+                                                kNoAnnotation, kNoAnnotation, kNoAnnotation, kNoAnnotation};
+  double configured_[kMaxNoiseValues] = {};
+  int configured_count_ = 0;
   std::uint64_t processed_ = 0;
 };
+
+inline void Adapter::annotate(Filter& f, int i, double value) const { f.set_annotation(first_annotation_ + i, value); }
 
 inline void Outputs::emit(const Truth& t) const {
   for (int i = 0; i < count_; ++i)

@@ -10,6 +10,9 @@ namespace trackflow {
 // (Eigen's MaxRows) so items never touch the heap.
 inline constexpr int kMaxStateDim = 16;
 inline constexpr int kMaxMeasDim = 6;
+// Named per-estimate values adapters publish (a quality grade, an adapted sigma): at most this
+// many per filter, over all its adapters.
+inline constexpr int kMaxAnnotations = 8;
 
 using StateVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, kMaxStateDim, 1>;
 using StateCov = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, kMaxStateDim, kMaxStateDim>;
@@ -37,7 +40,12 @@ struct Truth {
 
 // Spherical: value = [range, azimuth, elevation(, range_rate)].
 // Cartesian: value = [x, y, z(, range_rate)] in the ENU frame (origin included).
-enum class Frame : std::uint8_t { Spherical, Cartesian };
+enum class Frame : std::uint8_t { Spherical = 1, Cartesian = 2 };
+// The measurement frames a component accepts or produces (ComponentDecl), as a bit mask.
+using FrameMask = std::uint8_t;
+constexpr FrameMask mask(Frame f) { return static_cast<FrameMask>(f); }
+inline constexpr FrameMask kAnyFrame = 0xFF;
+const char* to_string(Frame f);
 
 // north_clockwise: compass bearing, x = r cos(el) sin(az), y = r cos(el) cos(az).
 // x_counterclockwise: mathematical angle from x (east) toward y (north).
@@ -62,6 +70,16 @@ struct Measurement {
   int position_dim() const { return 3; }
 };
 
+// Names and units of a filter's state components, in the order of Estimate::state.
+struct StateComponent {
+  const char* name;
+  const char* unit;
+};
+struct StateLayout {
+  const StateComponent* components = nullptr;
+  int dim = 0;
+};
+
 // What a filter publishes after each step. Whatever the filter's own state (Cartesian CV/CA,
 // spherical, ...), it also fills the ENU position/velocity block so metrics and sinks need
 // no knowledge of the state layout.
@@ -77,7 +95,10 @@ struct Estimate {
   MeasVec innovation;          // empty when not updated
   MeasCov innovation_covariance;
   double nis = 0.0;            // innovation' S^-1 innovation, valid when updated
-  int quality[3] = {-1, -1, -1};  // per-channel grade set by quality adapters, -1: none
+  // Values the filter's adapters publish, in the order of the names sinks receive in
+  // InputInfo::annotations; NaN: no value (yet).
+  double annotations[kMaxAnnotations] = {};
+  int annotation_count = 0;
 };
 
 // What a filter publishes while it is still collecting its first points: flagged, with a

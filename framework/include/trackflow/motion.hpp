@@ -1,6 +1,8 @@
 // Purpose: kinematic motion models (constant velocity, constant acceleration, Singer) with fixed-size F and Q.
 #pragma once
 
+#include <trackflow/items.hpp>
+
 #include <Eigen/Core>
 
 #include <array>
@@ -19,6 +21,18 @@ struct KinematicModel {
   using State = Eigen::Matrix<double, kDim, 1>;
   using Matrix = Eigen::Matrix<double, kDim, kDim>;
   using AxisMatrix = Eigen::Matrix<double, Order, Order>;
+
+  // Names and units of the state components (adapters, sinks).
+  static StateLayout state_layout() {
+    static constexpr StateComponent kCv[] = {{"x", "m"}, {"vx", "m/s"}, {"y", "m"},
+                                             {"vy", "m/s"}, {"z", "m"}, {"vz", "m/s"}};
+    static constexpr StateComponent kCa[] = {{"x", "m"},  {"vx", "m/s"}, {"ax", "m/s2"}, {"y", "m"}, {"vy", "m/s"},
+                                             {"ay", "m/s2"}, {"z", "m"}, {"vz", "m/s"}, {"az", "m/s2"}};
+    if constexpr (Order == 2)
+      return {kCv, kDim};
+    else
+      return {kCa, kDim};
+  }
 
   static constexpr int position_index(int axis) { return axis * Order; }
   static constexpr int velocity_index(int axis) { return axis * Order + 1; }

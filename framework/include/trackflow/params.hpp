@@ -5,6 +5,7 @@
 #include <trackflow/items.hpp>
 #include <trackflow/units.hpp>
 
+#include <initializer_list>
 #include <limits>
 #include <string>
 #include <string_view>
@@ -33,6 +34,7 @@ struct ParamSpec {
   bool required = false;
   std::string default_text;       // as an analyst would write it ("10 m"); empty: no default
   std::vector<std::string> choices;
+  std::vector<int> choice_values;  // Choice: the enum value of each word (see choice<E>)
   std::vector<ParamSpec> fields;  // Records only
   double min = -std::numeric_limits<double>::infinity();  // SI, inclusive
   double max = std::numeric_limits<double>::infinity();
@@ -44,8 +46,25 @@ struct ParamSpec {
   static ParamSpec integer(std::string name, std::string doc);
   static ParamSpec boolean(std::string name, std::string doc);
   static ParamSpec string(std::string name, std::string doc);
-  static ParamSpec choice(std::string name, std::vector<std::string> choices, std::string doc);
+  // A choice yields an enum declared beside its words, e.g.
+  //   enum class Init { TwoPoint, Explicit };
+  //   ParamSpec::choice<Init>("init", {{Init::TwoPoint, "two_point"}, {Init::Explicit, "explicit"}}, "...")
+  // and the plugin reads it as p.choice<Init>("init"): no string comparison, no silent fallback.
+  template <class E>
+  static ParamSpec choice(std::string name, std::initializer_list<std::pair<E, const char*>> options, std::string doc) {
+    std::vector<std::string> words;
+    std::vector<int> values;
+    for (const auto& [value, word] : options) {
+      words.emplace_back(word);
+      values.push_back(static_cast<int>(value));
+    }
+    ParamSpec s = choice_words(std::move(name), std::move(words), std::move(doc));
+    s.choice_values = std::move(values);
+    return s;
+  }
   static ParamSpec real_list(std::string name, Dimension d, std::string doc, int size = -1);
+  // A choice read only as its word (choice_word); prefer the typed form above.
+  static ParamSpec choice_words(std::string name, std::vector<std::string> choices, std::string doc);
   static ParamSpec records(std::string name, std::vector<ParamSpec> fields, std::string doc);
   ParamSpec def(std::string text) && { default_text = std::move(text); return std::move(*this); }
   ParamSpec req() && { required = true; return std::move(*this); }
@@ -60,6 +79,7 @@ struct ParamValue {
   ParamType type = ParamType::Real;
   double real = 0.0;
   long long integer = 0;
+  int choice = 0;  // Choice: the enum value declared for the word
   bool boolean = false;
   std::string text;
   std::vector<double> reals;
@@ -78,7 +98,10 @@ class Params {
   double real(std::string_view name) const;
   long long integer(std::string_view name) const;
   bool boolean(std::string_view name) const;
-  const std::string& text(std::string_view name) const;  // String and Choice
+  const std::string& text(std::string_view name) const;  // String only
+  template <class E>
+  E choice(std::string_view name) const { return static_cast<E>(get(name, ParamType::Choice).choice); }
+  const std::string& choice_word(std::string_view name) const;  // the word as written, for messages
   const std::vector<double>& reals(std::string_view name) const;
   Vec3 vec3(std::string_view name) const;                // RealList of size 3
   const std::vector<Params>& records(std::string_view name) const;

@@ -25,6 +25,10 @@ struct ComponentDecl {
   int min_inputs = 1;
   int max_inputs = 1;        // -1: unbounded
   ItemMask produces = 0;     // item kinds emitted
+  // Measurement frames (items.hpp) accepted on inputs and produced; the graph refuses a wire
+  // whose frames do not meet (e.g. spherical radar output into a Cartesian-only filter).
+  FrameMask accepts_frames = kAnyFrame;
+  FrameMask produces_frames = kAnyFrame;
   std::function<std::unique_ptr<Component>(const Params&)> create;
 };
 

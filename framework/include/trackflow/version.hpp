@@ -5,7 +5,7 @@ namespace trackflow {
 
 // Bump kAbiVersion whenever a type that crosses the plugin boundary changes layout or
 // a virtual function is added, removed or reordered. The loader refuses mismatches.
-inline constexpr int kAbiVersion = 2;
-inline constexpr const char* kSdkVersion = "0.1.0";
+inline constexpr int kAbiVersion = 3;
+inline constexpr const char* kSdkVersion = "0.3.0";
 
 }  // namespace trackflow

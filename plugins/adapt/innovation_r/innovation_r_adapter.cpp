@@ -5,7 +5,6 @@
 
 #include <algorithm>
 #include <cmath>
-#include <cstring>
 #include <limits>
 #include <string>
 
@@ -13,6 +12,9 @@ namespace trackflow {
 namespace {
 
 using adapt::ResidualREstimator;
+
+enum class PostFitTerm { Add, Subtract };
+enum class Covariance { FollowR, Keep };
 
 // The end-of-run state of one run; the aggregating instance sums these in run order.
 struct InnovationRRunResult final : RunResult {
@@ -22,7 +24,8 @@ struct InnovationRRunResult final : RunResult {
   double noise_factor = 0.0;          // sqrt(tr(R̄_nom⁻¹ R̂) / 3) at the end of the run
   double factor_sum = 0.0;            // the same after every adapting update, summed
   std::uint64_t factor_count = 0;
-  std::uint64_t updates = 0, floored = 0;
+  std::uint64_t updates = 0, floored = 0, rescales = 0;
+  double variance_factor = 1.0;  // the covariance rescale applied over the run (covariance: follow_r)
 };
 
 // How much larger than the measurements' own R the estimate is: sqrt of the mean generalised
@@ -35,26 +38,23 @@ double noise_factor(const ResidualREstimator& e) {
 
 class InnovationRAdapter final : public Adapter {
  public:
-  explicit InnovationRAdapter(adapt::EstimatorSettings s) : settings_(s), estimator_(s) {}
+  InnovationRAdapter(adapt::EstimatorSettings s, bool follow_r) : settings_(s), estimator_(s), follow_r_(follow_r) {}
 
-  std::string incompatibility(Filter& f) override {
-    const NoiseHandles h = f.noise();
-    if (!h.measurement_noise)
-      return "the filter does not expose its measurement noise R (Filter::noise() has no measurement_noise); "
-             "adapt.innovation_r needs a filter that takes R from its measurements, e.g. filter.kalman or "
-             "filter.decoupled";
-    const char* space = h.measurement_space ? h.measurement_space : "";
-    if (std::strcmp(space, "cartesian_position") != 0)
-      return std::string("the filter's R is in '") + space +
-             "' measurement space; adapt.innovation_r estimates R of Cartesian position measurements "
-             "(measurement space 'cartesian_position': filter.kalman, filter.decoupled)";
-    return {};
+  NoiseNeeds needs() const override {
+    NoiseNeeds n;
+    n.measurement = MeasurementSpace::CartesianPosition;
+    n.covariance = follow_r_;
+    return n;
   }
+
+  // The adapted R's standard deviations, per ENU axis (m), on every estimate.
+  std::vector<std::string> annotation_names() const override { return {"sigma_x", "sigma_y", "sigma_z"}; }
 
   void start_run(const RunContext&) override {
     estimator_ = ResidualREstimator(settings_);
-    updates_ = floored_ = run_factor_count_ = 0;
+    updates_ = floored_ = run_factor_count_ = rescales_ = 0;
     run_factor_sum_ = 0.0;
+    applied_variance_factor_ = 1.0;
   }
 
   void before_update(const Measurement& m, Filter& f) override {
@@ -65,11 +65,14 @@ class InnovationRAdapter final : public Adapter {
       estimator_.start(nominal);
     }
     if (!estimator_.adapting()) return;  // warm-up: the filter keeps the measurement's own R
-    MeasCov* R = f.noise().measurement_noise;
+    MeasCov* R = f.noise().measurement.R;
     if (R) *R = estimator_.estimate();
+    if (follow_r_) follow(f);
   }
 
-  void after_update(const Measurement& m, const Estimate& e, Filter&) override {
+  void after_update(const Measurement& m, const Estimate& e, Filter& f) override {
+    if (estimator_.adapting())
+      for (int i = 0; i < 3; ++i) annotate(f, i, std::sqrt(std::max(0.0, estimator_.estimate()(i, i))));
     if (!e.updated || !e.initialised || !m.valid || !estimator_.started() || m.value.size() < 3) return;
     const Vec3 residual = m.value.head<3>() - e.enu.head<3>();
     const Mat3 posterior = e.enu_covariance.topLeftCorner<3, 3>();
@@ -88,6 +91,7 @@ class InnovationRAdapter final : public Adapter {
 
   std::unique_ptr<RunResult> end_run() override {
     auto r = std::make_unique<InnovationRRunResult>();
+    r->rescales = rescales_;
     r->updates = updates_;
     r->floored = floored_;
     if (estimator_.started()) {
@@ -99,6 +103,7 @@ class InnovationRAdapter final : public Adapter {
       r->noise_factor = noise_factor(estimator_);
     }
     r->factor_sum = run_factor_sum_;
+    r->variance_factor = applied_variance_factor_;
     r->factor_count = run_factor_count_;
     return r;
   }
@@ -110,6 +115,8 @@ class InnovationRAdapter final : public Adapter {
     floored_total_ += r.floored;
     mean_factor_sum_ += r.factor_sum;
     mean_factor_count_ += r.factor_count;
+    rescales_total_ += r.rescales;
+    variance_factor_sum_ += r.variance_factor;
     if (!r.has_estimate) return;
     ++runs_with_estimate_;
     sigma_sum_ += r.sigma;
@@ -133,6 +140,10 @@ class InnovationRAdapter final : public Adapter {
     if (mean_factor_count_ > 0)
       s.metric("noise_factor_mean", mean_factor_sum_ / static_cast<double>(mean_factor_count_));
     s.metric("updates", static_cast<double>(updates_total_));
+    if (follow_r_) {
+      s.metric("covariance_rescales", static_cast<double>(rescales_total_));
+      s.metric("covariance_factor_mean", variance_factor_sum_ / static_cast<double>(runs_));
+    }
     s.metric("floor_fraction",
              updates_total_ ? static_cast<double>(floored_total_) / static_cast<double>(updates_total_) : 0.0);
     s.notes.push_back("final R-hat of each run (ENU sigmas), averaged over " + std::to_string(runs_with_estimate_) +
@@ -144,8 +155,29 @@ class InnovationRAdapter final : public Adapter {
   }
 
  private:
+  // covariance: follow_r. The filter's P was built with the R it used (the measurements' own during
+  // the warm-up); when R-hat says the noise is k^2 times larger, the true error covariance is
+  // about k^2 times P too (P0 and the measurement-dominated part of P scale with R). P is rescaled
+  // by the change of k^2 = tr(R_nom^-1 R-hat)/3 since the last step, so over a run it has followed
+  // R-hat's growth once; the filter's own updates then settle it. Without this the gains
+  // collapse when R-hat grows while P still claims the small start-up error.
+  void follow(Filter& f) {
+    const double k = noise_factor(estimator_);
+    if (!std::isfinite(k) || !(k > 0.0)) return;
+    const double variance_factor = k * k;
+    const double step = variance_factor / applied_variance_factor_;
+    if (std::abs(step - 1.0) < 1e-12) return;
+    f.scale_covariance(step);
+    applied_variance_factor_ = variance_factor;
+    ++rescales_;
+  }
+
   adapt::EstimatorSettings settings_;
   ResidualREstimator estimator_;
+  bool follow_r_ = true;
+  double applied_variance_factor_ = 1.0;
+  std::uint64_t rescales_ = 0, rescales_total_ = 0;
+  double variance_factor_sum_ = 0.0;
   std::uint64_t updates_ = 0, floored_ = 0, run_factor_count_ = 0;
   double run_factor_sum_ = 0.0;
   // Aggregating instance.
@@ -166,7 +198,11 @@ const char* const kDoc =
     "definite; eq 28 prints '-' (post_fit_term: subtract reproduces it; it is biased low). Floor: R >= "
     "floor_ratio^2 times the measurement's own R (generalised eigenvalues raised), then every eigenvalue >= "
     "floor_sigma^2. Starts from the first measurement's covariance. Needs a filter exposing R in measurement space "
-    "cartesian_position (filter.kalman, filter.decoupled). Reports the final R-hat sigmas averaged over runs.";
+    "cartesian_position (filter.kalman, filter.decoupled). covariance: follow_r (default; not in the paper) also "
+    "rescales the filter's state covariance P by the change of the noise factor squared at every adapting step, so "
+    "that P, built with the nominal R during the warm-up, follows R-hat as it grows (this removes the ADKF start-up "
+    "transient; docs/papers/001-rbs-landing.md). Publishes R-hat's sigmas per ENU axis as annotations sigma_x, "
+    "sigma_y, sigma_z. Reports the final R-hat sigmas averaged over runs.";
 
 void register_components(Registrar& r) {
   ComponentDecl d;
@@ -186,22 +222,26 @@ void register_components(Registrar& r) {
           .at_least(0)
           .at_most(1),
       ParamSpec::real("floor_sigma", dim::length, "every eigenvalue of R-hat is kept >= floor_sigma^2").def("1 mm").positive(),
-      ParamSpec::choice("post_fit_term", {"add", "subtract"},
+      ParamSpec::choice<PostFitTerm>("post_fit_term", {{PostFitTerm::Add, "add"}, {PostFitTerm::Subtract, "subtract"}},
                         "R_s = dz dz' + H P+ H' (add: unbiased) or - H P+ H' (subtract: eq 28 as printed)")
           .def("add"),
       ParamSpec::integer("warmup", "updates after initialisation whose residuals are not used (0: from the first, as the paper)")
           .def("50")
           .at_least(0)
           .at_most(1000000),
+      ParamSpec::choice<Covariance>("covariance", {{Covariance::FollowR, "follow_r"}, {Covariance::Keep, "keep"}},
+                                    "rescale the filter's state covariance P as R-hat grows or shrinks (follow_r: by the "
+                                    "change of the noise factor squared; not in the paper) or leave P alone (keep)")
+          .def("follow_r"),
   };
   d.create = [](const Params& p) {
     adapt::EstimatorSettings s;
     s.window = static_cast<int>(p.integer("window"));
     s.floor_ratio = p.real("floor_ratio");
     s.floor_sigma = p.real("floor_sigma");
-    s.add_posterior = p.text("post_fit_term") == "add";
+    s.add_posterior = p.choice<PostFitTerm>("post_fit_term") == PostFitTerm::Add;
     s.warmup = static_cast<int>(p.integer("warmup"));
-    return std::make_unique<InnovationRAdapter>(s);
+    return std::make_unique<InnovationRAdapter>(s, p.choice<Covariance>("covariance") == Covariance::FollowR);
   };
   r.add(std::move(d));
 }

@@ -34,8 +34,8 @@ struct Attached {
     a = dynamic_cast<Adapter*>(adapter.get());
     REQUIRE(f);
     REQUIRE(a);
-    REQUIRE(a->incompatibility(*f).empty());
-    REQUIRE(f->attach(a));
+    REQUIRE(noise_mismatch(a->needs(), f->noise(), f->has_covariance_access()).empty());
+    REQUIRE(f->attach(a, static_cast<int>(a->annotation_names().size())));
     out.attach_to(*filter);
   }
   void start_run(std::uint64_t run, Diagnostics& d) {
@@ -44,7 +44,7 @@ struct Attached {
     out.estimates.clear();
   }
   // R the filter used for the latest measurement (the adapter writes it in before_update).
-  Mat3 filter_R() const { return f->noise().measurement_noise->topLeftCorner<3, 3>(); }
+  Mat3 filter_R() const { return f->noise().measurement.R->topLeftCorner<3, 3>(); }
 };
 
 // One run of a target with the continuous white acceleration (PSD q) the filters assume, so that
@@ -178,8 +178,8 @@ TEST_CASE("incompatibility names what is missing") {
     MeasCov R = MeasCov::Identity(3, 3);
     NoiseHandles noise() override {
       NoiseHandles h;
-      h.measurement_noise = &R;
-      h.measurement_space = "spherical";
+      h.measurement.R = &R;
+      h.measurement.space = MeasurementSpace::Spherical;
       return h;
     }
   };
@@ -188,11 +188,11 @@ TEST_CASE("incompatibility names what is missing") {
   REQUIRE(a);
   NoR no_r;
   SphericalR spherical;
-  CHECK_THAT(a->incompatibility(no_r), Catch::Contains("does not expose its measurement noise R"));
-  CHECK_THAT(a->incompatibility(spherical), Catch::Contains("'spherical'") && Catch::Contains("cartesian_position"));
+  CHECK_THAT(noise_mismatch(a->needs(), no_r.noise(), no_r.has_covariance_access()), Catch::Contains("exposes no measurement noise"));
+  CHECK_THAT(noise_mismatch(a->needs(), spherical.noise(), spherical.has_covariance_access()), Catch::Contains("'spherical'") && Catch::Contains("cartesian_position"));
   for (const char* type : {"filter.kalman", "filter.decoupled"}) {
     auto f = test::make(type);
-    CHECK(a->incompatibility(*dynamic_cast<Filter*>(f.get())).empty());
+    CHECK(noise_mismatch(a->needs(), dynamic_cast<Filter*>(f.get())->noise(), dynamic_cast<Filter*>(f.get())->has_covariance_access()).empty());
   }
   CHECK_THROWS_WITH(test::make("adapt.innovation_r", "{ window: 0 }"), Catch::Contains("window"));
 }

@@ -1,19 +1,17 @@
 // Purpose: adapt.quality_switch — grades each radar channel BEST/NORMAL/WORST from the RMS of successive differences and switches q and R from beacon/skin tables (paper 000 §III.2).
-#include "channel_noise.hpp"
 #include "difference_window.hpp"
 
 #include <trackflow/geometry.hpp>
+#include <trackflow/noise.hpp>
 #include <trackflow/plugin.hpp>
 
 #include <array>
 #include <cmath>
-#include <cstring>
 #include <string>
 
 namespace trackflow {
 namespace {
 
-using adapt::ChannelPsd;
 using adapt::DifferenceWindow;
 using adapt::Grade;
 using adapt::kGrades;
@@ -32,7 +30,6 @@ struct GradeRow {
 };
 
 enum class Table : int { Beacon = 0, Skin = 1 };
-enum class QLayout { EnuAxes, LineOfSight };
 
 struct Settings {
   int window = 10;
@@ -42,7 +39,6 @@ struct Settings {
   GradeRow rows[2][kGrades];  // [table][grade]
   Table unknown_mode = Table::Beacon;
   Grade initial = Grade::Normal;
-  QLayout layout = QLayout::EnuAxes;
 };
 
 // The counts of one run; the aggregating instance sums them in run order.
@@ -61,21 +57,21 @@ class QualitySwitchAdapter final : public Adapter {
         windows_{DifferenceWindow(s.window, false, s.detrend), DifferenceWindow(s.window, true, s.detrend),
                  DifferenceWindow(s.window, false, s.detrend)} {}
 
-  std::string incompatibility(Filter& f) override {
-    const NoiseHandles h = f.noise();
-    if (!h.measurement_noise || !h.process_noise)
-      return "the filter does not expose both its R and its process noise q (Filter::noise()); "
-             "adapt.quality_switch retunes both (filter.ekf, filter.ekf_spherical, filter.ukf)";
-    const char* space = h.measurement_space ? h.measurement_space : "";
-    if (std::strcmp(space, "spherical") != 0)
-      return std::string("the filter's R is in '") + space +
-             "' measurement space; adapt.quality_switch sets R of [range, azimuth, elevation] measurements "
-             "(measurement space 'spherical': filter.ekf, filter.ekf_spherical, filter.ukf)";
-    if (h.process_noise_count != 3)
-      return "the filter exposes " + std::to_string(h.process_noise_count) +
-             " process-noise intensities; adapt.quality_switch writes three (one per ENU axis or per line-of-sight "
-             "channel, see filter_q)";
-    return {};
+  // R of [range, azimuth, elevation]; white-jerk PSDs per ENU axis or per line-of-sight channel
+  // (converted from the per-channel table rows with the SDK's helpers, whichever the filter has).
+  NoiseNeeds needs() const override {
+    NoiseNeeds n;
+    n.measurement = MeasurementSpace::Spherical;
+    n.process = true;
+    n.process_kind = NoiseKind::SpectralDensity;
+    n.process_dimension = dim::jerk_psd;
+    n.process_axes = mask(NoiseAxes::Enu) | mask(NoiseAxes::LineOfSight);
+    return n;
+  }
+
+  // The grade per channel: 0 best, 1 normal, 2 worst; no value until the channel is graded.
+  std::vector<std::string> annotation_names() const override {
+    return {"grade_range", "grade_azimuth", "grade_elevation"};
   }
 
   void start_run(const RunContext&) override {
@@ -117,7 +113,7 @@ class QualitySwitchAdapter final : public Adapter {
     bool graded_all = true;
     for (int c = 0; c < kChannels; ++c) {
       graded_all &= grade_[c] >= 0;
-      f.set_quality(c, grade_[c]);
+      if (grade_[c] >= 0) annotate(f, c, grade_[c]);
     }
     if (!graded_all) ++run_.ungraded;
     apply(table, f);
@@ -169,9 +165,9 @@ class QualitySwitchAdapter final : public Adapter {
     }
     if (total_.rms_count[0] == 0)
       s.notes.push_back("no channel was ever graded: fewer than window + 1 consecutive valid measurements per run");
-    s.notes.push_back("grades per channel are written to each estimate (Estimate::quality: 0 best, 1 normal, "
-                      "2 worst, -1 not yet graded); mean_rmse_*: the mean of the graded RMS of differences, the "
-                      "paper's 'RMSE mean' to set reference_* from");
+    s.notes.push_back("grades per channel are published on each estimate as annotations grade_range, grade_azimuth, "
+                      "grade_elevation (0 best, 1 normal, 2 worst, none until graded); mean_rmse_*: the mean of the "
+                      "graded RMS of differences, the paper's 'RMSE mean' to set reference_* from");
   }
 
  private:
@@ -197,24 +193,16 @@ class QualitySwitchAdapter final : public Adapter {
       const int g = grade_[c] >= 0 ? grade_[c] : static_cast<int>(s_.initial);
       row[c] = &s_.rows[static_cast<int>(table)][g];
     }
-    if (h.process_noise && h.process_noise_count == 3) {
-      if (!has_base_q_) {  // the first call ever: nothing has been written yet
-        for (int i = 0; i < 3; ++i) base_q_[i] = h.process_noise[i];
-        has_base_q_ = true;
-      }
-      if (has_geometry_) {
-        const ChannelPsd q{row[0]->q_range, row[1]->q_angle, row[2]->q_angle};
-        const Vec3 mapped = s_.layout == QLayout::LineOfSight
-                                ? adapt::line_of_sight_psd(q, rae_(0), rae_(2))
-                                : adapt::enu_axis_psd(q, rae_(0), rae_(1), rae_(2), convention_);
-        for (int i = 0; i < 3; ++i) h.process_noise[i] = mapped(i);
-      } else {
-        // No geometry yet in this run (no valid measurement so far): the filter's own q, not
-        // what the previous run on this thread left, so every run starts alike.
-        for (int i = 0; i < 3; ++i) h.process_noise[i] = base_q_[i];
-      }
+    // No geometry yet in this run (no valid measurement so far): the filter keeps its own q,
+    // which the engine restored at the start of the run.
+    if (h.process && h.process.count == 3 && has_geometry_) {
+      const ChannelPsd q{row[0]->q_range, row[1]->q_angle, row[2]->q_angle};
+      const Vec3 mapped = h.process.axes == NoiseAxes::LineOfSight
+                              ? line_of_sight_psd(q, rae_(0), rae_(2))
+                              : enu_axis_psd(q, rae_(0), rae_(1), rae_(2), convention_);
+      for (int i = 0; i < 3; ++i) h.process.values[i] = mapped(i);
     }
-    MeasCov* R = h.measurement_noise;
+    MeasCov* R = h.measurement.R;
     if (!R || R->rows() < 3 || R->cols() < 3) return;
     const double sigma[kChannels] = {row[0]->sigma_range, row[1]->sigma_angle, row[2]->sigma_angle};
     for (int c = 0; c < kChannels; ++c) {
@@ -231,8 +219,6 @@ class QualitySwitchAdapter final : public Adapter {
   Vec3 rae_ = Vec3::Zero();
   AzimuthConvention convention_ = AzimuthConvention::NorthClockwise;
   bool has_geometry_ = false;
-  double base_q_[3] = {};  // the filter's configured q, captured before the adapter first writes
-  bool has_base_q_ = false;
   QualityRunResult run_;
   QualityRunResult total_;  // aggregating instance
 };
@@ -242,9 +228,8 @@ void read_table(const Params& p, const char* name, GradeRow (&rows)[kGrades]) {
   const auto& records = p.records(name);
   bool seen[kGrades] = {};
   for (const Params& rec : records) {
-    const std::string& g = rec.text("grade");
-    const int i = g == "best" ? 0 : g == "normal" ? 1 : 2;
-    if (seen[i]) throw rec.error("grade", "grade '" + g + "' appears twice in '" + name + "'");
+    const int i = static_cast<int>(rec.choice<Grade>("grade"));
+    if (seen[i]) throw rec.error("grade", "grade '" + rec.choice_word("grade") + "' appears twice in '" + name + "'");
     seen[i] = true;
     rows[i].q_range = rec.real("q_range");
     rows[i].q_angle = rec.real("q_angle");
@@ -257,9 +242,13 @@ void read_table(const Params& p, const char* name, GradeRow (&rows)[kGrades]) {
                               "': give one row each for best, normal and worst");
 }
 
+ParamSpec grade_param(const char* name, const char* doc) {
+  return ParamSpec::choice<Grade>(name, {{Grade::Best, "best"}, {Grade::Normal, "normal"}, {Grade::Worst, "worst"}}, doc);
+}
+
 std::vector<ParamSpec> row_fields() {
   return {
-      ParamSpec::choice("grade", {"best", "normal", "worst"}, "the grade this row applies to").req(),
+      grade_param("grade", "the grade this row applies to").req(),
       ParamSpec::real("q_range", dim::jerk_psd, "range-channel white-jerk PSD q_r (paper: cm2, i.e. cm2/s5)").req().at_least(0),
       ParamSpec::real("q_angle", kAngularJerkPsd, "azimuth and elevation white-jerk PSD q_θ = q_φ (paper: urad2, i.e. urad2/s5)")
           .req()
@@ -290,13 +279,14 @@ const char* const kDoc =
     "sigma_range, the azimuth and elevation grades each pick q_angle and sigma_angle. R: the diagonal of the "
     "[range, azimuth, elevation] block is replaced (a range-rate entry is kept). q: the channel PSDs (q_r m2/s5; q_az, "
     "q_el rad2/s5) become linear PSDs along the line of sight [q_r, (r cos el)^2 q_az, r^2 q_el] at the filter's latest "
-    "estimate; filter_q: line_of_sight writes these (filter.ekf_spherical's q_r, q_h, q_v), enu_axes writes the "
-    "diagonal of J diag(q) J' (filter.ekf or filter.ukf with motion: constant_acceleration, q_jerk per ENU axis; the cross-axis "
-    "terms are dropped). Invalid (unlocked) or non-finite measurements: not graded, and the windows restart after "
+    "estimate; to a filter whose q is per line-of-sight channel these are written (filter.ekf_spherical's q_r, q_h, "
+    "q_v), to one whose q is per ENU axis the diagonal of J diag(q) J' (filter.ekf or filter.ukf with motion: "
+    "constant_acceleration, q_jerk per ENU axis; the cross-axis terms are dropped). Any other filter is refused "
+    "when the pipeline is built (the typed noise handles say what each q is). Invalid (unlocked) or non-finite measurements: not graded, and the windows restart after "
     "them (no difference across a gap); the grades in force are kept and the filter coasts. Until a channel's window "
     "holds `window` differences it uses initial_grade and is reported as not graded. The grade per channel is "
-    "stamped on each estimate (Estimate::quality: 0 best, 1 normal, 2 worst, -1 not graded; sink.csv columns "
-    "quality_*). Defaults: Table 12's reference means and Table 13's tables. See docs/filters.md.";
+    "published on each estimate as annotations grade_range, grade_azimuth, grade_elevation (0 best, 1 normal, 2 worst, "
+    "none until graded; sink.csv columns <adapter id>.grade_*). Defaults: Table 12's reference means and Table 13's tables. See docs/filters.md.";
 
 void register_components(Registrar& r) {
   ComponentDecl d;
@@ -332,13 +322,10 @@ void register_components(Registrar& r) {
           .def(kBeaconTable13),
       ParamSpec::records("skin", row_fields(), "q and R per grade in skin mode (default: paper 000 Table 13)")
           .def(kSkinTable13),
-      ParamSpec::choice("unknown_mode", {"beacon", "skin"}, "table for measurements whose mode is neither").def("beacon"),
-      ParamSpec::choice("initial_grade", {"best", "normal", "worst"}, "grade used until a channel's window is full")
-          .def("normal"),
-      ParamSpec::choice("filter_q", {"enu_axes", "line_of_sight"},
-                        "the attached filter's three q: per ENU axis (filter.ekf/ukf, constant_acceleration) or per "
-                        "line-of-sight channel (filter.ekf_spherical); both white-jerk PSDs in m2/s5")
-          .def("enu_axes"),
+      ParamSpec::choice<Table>("unknown_mode", {{Table::Beacon, "beacon"}, {Table::Skin, "skin"}},
+                               "table for measurements whose mode is neither")
+          .def("beacon"),
+      grade_param("initial_grade", "grade used until a channel's window is full").def("normal"),
   };
   d.create = [](const Params& p) {
     Settings s;
@@ -353,10 +340,8 @@ void register_components(Registrar& r) {
     s.worst_above = limits[1];
     read_table(p, "beacon", s.rows[0]);
     read_table(p, "skin", s.rows[1]);
-    s.unknown_mode = p.text("unknown_mode") == "skin" ? Table::Skin : Table::Beacon;
-    const std::string& g = p.text("initial_grade");
-    s.initial = g == "best" ? Grade::Best : g == "worst" ? Grade::Worst : Grade::Normal;
-    s.layout = p.text("filter_q") == "line_of_sight" ? QLayout::LineOfSight : QLayout::EnuAxes;
+    s.unknown_mode = p.choice<Table>("unknown_mode");
+    s.initial = p.choice<Grade>("initial_grade");
     return std::make_unique<QualitySwitchAdapter>(s);
   };
   r.add(std::move(d));

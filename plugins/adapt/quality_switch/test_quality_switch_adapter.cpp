@@ -13,6 +13,11 @@ using namespace trackflow;
 
 namespace {
 
+// The grade the adapter published on an estimate for a channel (its annotations 0..2), -1: none yet.
+int grade(const Estimate& e, int channel) {
+  return channel < e.annotation_count && !std::isnan(e.annotations[channel]) ? static_cast<int>(e.annotations[channel]) : -1;
+}
+
 constexpr double kR0 = 100e3, kAz0 = 0.5, kEl0 = 0.2;
 
 // Tables whose every entry differs, so that a read-back names the row it came from.
@@ -61,8 +66,8 @@ struct Attached {
     a = dynamic_cast<Adapter*>(adapter.get());
     REQUIRE(f);
     REQUIRE(a);
-    REQUIRE(a->incompatibility(*f).empty());
-    REQUIRE(f->attach(a));
+    REQUIRE(noise_mismatch(a->needs(), f->noise(), f->has_covariance_access()).empty());
+    REQUIRE(f->attach(a, static_cast<int>(a->annotation_names().size())));
     out.attach_to(*filter);
     filter->start_run({0, 1, &diag});
     adapter->start_run({0, 1, &diag});
@@ -72,7 +77,7 @@ struct Attached {
     REQUIRE(!out.estimates.empty());
     return out.estimates.back();
   }
-  double R(int i) const { return (*f->noise().measurement_noise)(i, i); }
+  double R(int i) const { return (*f->noise().measurement.R)(i, i); }
   Summary summary() {
     auto r = adapter->end_run();
     adapter->merge(*r);
@@ -109,21 +114,21 @@ TEST_CASE("the adapter writes the graded rows' R and q into filter.ekf (read bac
     const Estimate before = s.out.estimates.empty() ? Estimate{} : s.out.estimates.back();
     const Estimate& e = s.step(meas(0.025 * k, kR0 + 0.5 * k, kAz0 + 1.5e-3 * k, kEl0 + 3e-3 * k));
     if (k < 2) {
-      for (int c = 0; c < 3; ++c) CHECK(e.quality[c] == -1);  // window of 2 differences not yet full
+      for (int c = 0; c < 3; ++c) CHECK(grade(e, c) == -1);  // window of 2 differences not yet full
       continue;
     }
-    CHECK(e.quality[0] == 0);
-    CHECK(e.quality[1] == 1);
-    CHECK(e.quality[2] == 2);
+    CHECK(grade(e, 0) == 0);
+    CHECK(grade(e, 1) == 1);
+    CHECK(grade(e, 2) == 2);
     CHECK(s.R(0) == Approx(std::pow(table_sigma_range(0, 0), 2)));
     CHECK(s.R(1) == Approx(std::pow(table_sigma_angle(0, 1), 2)));
     CHECK(s.R(2) == Approx(std::pow(table_sigma_angle(0, 2), 2)));
-    CHECK((*s.f->noise().measurement_noise)(0, 1) == 0.0);
+    CHECK((*s.f->noise().measurement.R)(0, 1) == 0.0);
     // q was set before this update from the previous estimate's geometry.
     REQUIRE(before.initialised);
     const Vec3 expected = expected_enu_q(before.enu.head<3>() - Vec3(100.0, -50.0, 10.0), table_q_range(0, 0),
                                          table_q_angle(0, 1), table_q_angle(0, 2));
-    const double* q = s.f->noise().process_noise;
+    const double* q = s.f->noise().process.values;
     for (int i = 0; i < 3; ++i) CHECK(q[i] == Approx(expected(i)).epsilon(1e-6));
   }
   const Summary sum = s.summary();
@@ -151,7 +156,7 @@ TEST_CASE("grades at the thresholds: RMSE = M is BEST, = 2M is NORMAL, just abov
   for (int k = 0; k < 11; ++k) {
     const Estimate& e = s.step(meas(0.025 * k, kR0 + r[k]));
     INFO("k = " << k);
-    CHECK(e.quality[0] == expected[k]);
+    CHECK(grade(e, 0) == expected[k]);
     if (expected[k] >= 0) CHECK(s.R(0) == Approx(std::pow(table_sigma_range(0, expected[k]), 2)));
   }
 }
@@ -167,10 +172,10 @@ TEST_CASE("the table follows the measurement's mode; unknown_mode picks the tabl
       const Estimate& e = s.step(meas(0.025 * k, kR0 + 0.5 * k, kAz0, kEl0, modes[k]));  // all BEST once graded
       const int table = modes[k] == MeasMode::Skin || (modes[k] == MeasMode::Unknown && std::string(unknown) == "skin");
       skin_steps += table;
-      const int grade = e.quality[0] >= 0 ? e.quality[0] : 1;  // initial_grade normal
+      const int range_grade = grade(e, 0) >= 0 ? grade(e, 0) : 1;  // initial_grade normal
       INFO("k = " << k << ", unknown_mode " << unknown);
-      CHECK(s.R(0) == Approx(std::pow(table_sigma_range(table, grade), 2)));
-      CHECK(s.R(1) == Approx(std::pow(table_sigma_angle(table, e.quality[1] >= 0 ? e.quality[1] : 1), 2)));
+      CHECK(s.R(0) == Approx(std::pow(table_sigma_range(table, range_grade), 2)));
+      CHECK(s.R(1) == Approx(std::pow(table_sigma_angle(table, grade(e, 1) >= 0 ? grade(e, 1) : 1), 2)));
     }
     const Summary sum = s.summary();
     CHECK(sum.find("skin_table_steps")->value == skin_steps);
@@ -183,14 +188,14 @@ TEST_CASE("an invalid sample: the filter coasts, the grade is held, no differenc
   // BEST with 0.5 m steps, then an unlocked sample, then the track resumes 50 m further on.
   for (int k = 0; k < 6; ++k) s.step(meas(0.025 * k, kR0 + 0.5 * k));
   const Estimate last_valid = s.out.estimates.back();
-  REQUIRE(last_valid.quality[0] == 0);
+  REQUIRE(grade(last_valid, 0) == 0);
   const Estimate& coast = s.step(meas(0.15, 0.0, 0.0, 0.0, MeasMode::Beacon, /*valid=*/false));
   CHECK(coast.initialised);
   CHECK_FALSE(coast.updated);
   CHECK(coast.time == 0.15);
   CHECK(coast.enu.allFinite());
   CHECK((coast.enu.head<3>() - last_valid.enu.head<3>()).norm() > 0.0);  // predicted forward, not frozen
-  CHECK(coast.quality[0] == 0);                                          // held
+  CHECK(grade(coast, 0) == 0);                                          // held
   // After the gap: 50 m on, then 0.5 m steps. Bridging the gap would give a 50 m difference
   // (WORST) as soon as the window of two is full; restarting it keeps BEST held, then BEST.
   const int expected[] = {0, 0, 0, 0};
@@ -198,7 +203,7 @@ TEST_CASE("an invalid sample: the filter coasts, the grade is held, no differenc
     const Estimate& e = s.step(meas(0.175 + 0.025 * k, kR0 + 53.0 + 0.5 * k));
     INFO("k = " << k);
     CHECK(e.updated);
-    CHECK(e.quality[0] == expected[k]);
+    CHECK(grade(e, 0) == expected[k]);
   }
   const Summary sum = s.summary();
   CHECK(sum.find("invalid_steps")->value == 1);
@@ -211,30 +216,32 @@ TEST_CASE("an invalid sample: the filter coasts, the grade is held, no differenc
 TEST_CASE("a run that starts unlocked gets the filter's own q back, not the previous run's") {
   Attached s;
   for (int k = 0; k < 5; ++k) s.step(meas(0.025 * k, kR0 + 0.5 * k));
-  REQUIRE(s.f->noise().process_noise[0] != 7.0);  // adapted
+  REQUIRE(s.f->noise().process.values[0] != 7.0);  // adapted
   s.filter->start_run({1, 1, &s.diag});
   s.adapter->start_run({1, 1, &s.diag});
   s.step(meas(0.0, 0.0, 0.0, 0.0, MeasMode::Beacon, /*valid=*/false));
-  for (int i = 0; i < 3; ++i) CHECK(s.f->noise().process_noise[i] == 7.0);  // q_jerk of the filter
+  for (int i = 0; i < 3; ++i) CHECK(s.f->noise().process.values[i] == 7.0);  // q_jerk of the filter
   s.step(meas(0.025, kR0));
-  CHECK(s.f->noise().process_noise[0] != 7.0);  // geometry known: the table's again
+  CHECK(s.f->noise().process.values[0] != 7.0);  // geometry known: the table's again
 }
 
-TEST_CASE("filter_q: line_of_sight writes [q_r, (r cos el)^2 q_az, r^2 q_el] at the published estimate") {
+TEST_CASE("to a line-of-sight q the adapter writes [q_r, (r cos el)^2 q_az, r^2 q_el] at the published estimate") {
   struct StubFilter : Filter {
     MeasCov R = MeasCov::Identity(3, 3);
     double q[3] = {-1, -1, -1};
-    NoiseHandles noise() override { return {&R, q, 3, "spherical"}; }
+    NoiseHandles noise() override {
+      return {{&R, MeasurementSpace::Spherical}, {q, 3, NoiseKind::SpectralDensity, dim::jerk_psd, NoiseAxes::LineOfSight}};
+    }
     void step(const Measurement& m, Estimate& e) {
       before_update(m);
       publish(m, e);
     }
   };
-  auto adapter = test::make("adapt.quality_switch", "{ filter_q: line_of_sight }");
+  auto adapter = test::make("adapt.quality_switch");
   auto* a = dynamic_cast<Adapter*>(adapter.get());
   StubFilter f;
-  REQUIRE(a->incompatibility(f).empty());
-  REQUIRE(f.attach(a));
+  REQUIRE(noise_mismatch(a->needs(), f.noise(), f.has_covariance_access()).empty());
+  REQUIRE(f.attach(a, static_cast<int>(a->annotation_names().size())));
   test::Collector out;
   out.attach_to(f);
   Diagnostics d;
@@ -256,22 +263,22 @@ TEST_CASE("filter_q: line_of_sight writes [q_r, (r cos el)^2 q_az, r^2 q_el] at 
   CHECK(f.q[2] == Approx(150e3 * 150e3 * 0.01e-12));
   CHECK(f.R(0, 0) == Approx(0.5 * 0.5));
   CHECK(f.R(1, 1) == Approx(50e-6 * 50e-6));
-  CHECK(out.estimates.back().quality[0] == -1);
+  CHECK(grade(out.estimates.back(), 0) == -1);
 }
 
 TEST_CASE("incompatible filters and bad tables are refused with the reason") {
   auto adapter = test::make("adapt.quality_switch");
   auto* a = dynamic_cast<Adapter*>(adapter.get());
   auto kalman = test::make("filter.kalman");
-  CHECK_THAT(a->incompatibility(*dynamic_cast<Filter*>(kalman.get())),
+  CHECK_THAT(noise_mismatch(a->needs(), dynamic_cast<Filter*>(kalman.get())->noise(), dynamic_cast<Filter*>(kalman.get())->has_covariance_access()),
              Catch::Contains("'cartesian_position'") && Catch::Contains("spherical"));
   struct NoQ : Filter {
     MeasCov R = MeasCov::Identity(3, 3);
-    NoiseHandles noise() override { return {&R, nullptr, 0, "spherical"}; }
+    NoiseHandles noise() override { return {{&R, MeasurementSpace::Spherical}, {}}; }
   } no_q;
-  CHECK_THAT(a->incompatibility(no_q), Catch::Contains("process noise"));
+  CHECK_THAT(noise_mismatch(a->needs(), no_q.noise(), no_q.has_covariance_access()), Catch::Contains("process noise"));
   auto ekf = test::make("filter.ekf", "{ motion: constant_acceleration }");
-  CHECK(a->incompatibility(*dynamic_cast<Filter*>(ekf.get())).empty());
+  CHECK(noise_mismatch(a->needs(), dynamic_cast<Filter*>(ekf.get())->noise(), dynamic_cast<Filter*>(ekf.get())->has_covariance_access()).empty());
 
   const std::string row = "{grade: best, q_range: 1 m2/s5, q_angle: 1e-12 rad2/s5}";
   CHECK_THROWS_WITH(test::make("adapt.quality_switch", "{ beacon: [" + row + ", " + row + "] }"),

@@ -50,6 +50,7 @@ void register_components(Registrar& r) {
           "(see docs/converters.md). Cartesian inputs pass through unchanged.";
   d.accepts = mask(ItemKind::Measurement);
   d.produces = mask(ItemKind::Measurement);
+  d.produces_frames = mask(Frame::Cartesian);  // valid measurements; invalid ones pass unconverted
   d.create = [](const Params&) { return std::make_unique<ClassicalConverter>(); };
   r.add(std::move(d));
 }

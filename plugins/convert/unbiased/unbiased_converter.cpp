@@ -18,6 +18,7 @@ void register_components(Registrar& r) {
           "See docs/converters.md.";
   d.accepts = mask(ItemKind::Measurement);
   d.produces = mask(ItemKind::Measurement);
+  d.produces_frames = mask(Frame::Cartesian);  // valid measurements; invalid ones pass unconverted
   d.create = [](const Params& p) {
     return std::make_unique<conversion::StatisticalConverter>("convert.unbiased", p.node(), &conversion::unbiased);
   };

@@ -1,6 +1,7 @@
 // Purpose: settings of the Cartesian-state radar filters (filter.ekf, filter.ukf) — motion and noise model, range-rate use, initialisation — with their parameter declarations and parsing.
 #pragma once
 
+#include <trackflow/filter_front_end.hpp>
 #include <trackflow/items.hpp>
 #include <trackflow/params.hpp>
 #include <trackflow/units.hpp>
@@ -16,8 +17,11 @@ struct Settings {
   enum class Noise { Continuous, Discrete, Singer } noise = Noise::Continuous;
   double intensity = 1.0;
   double singer_alpha = 1.0;
-  enum class RangeRate { Auto, Use, Ignore } range_rate = RangeRate::Auto;
+  RangeRateUse range_rate = RangeRateUse::Auto;
   enum class Init { TwoPoint, Explicit, Paper000 } init = Init::TwoPoint;
+  // Near the zenith: add the angles' curvature variance to R and drop the azimuth while the
+  // zenith lies within 3 sigma (curvature), or the textbook EKF that does neither.
+  enum class Zenith { Curvature, Textbook } zenith = Zenith::Curvature;
   Vec3 p0 = Vec3::Zero(), v0 = Vec3::Zero(), a0 = Vec3::Zero();
   double sp0 = 0, sv0 = 0, sa0 = 0;  // initial standard deviations
   std::string type;                  // component type, for messages ("filter.ekf")
@@ -30,7 +34,11 @@ struct Settings {
 // Motion, noise, range-rate and initialisation parameters every Cartesian radar filter takes.
 inline std::vector<ParamSpec> param_specs() {
   return {
-      ParamSpec::choice("motion", {"constant_velocity", "constant_acceleration", "singer"}, "motion model")
+      ParamSpec::choice<Settings::Motion>("motion",
+                                          {{Settings::Motion::ConstantVelocity, "constant_velocity"},
+                                           {Settings::Motion::ConstantAcceleration, "constant_acceleration"},
+                                           {Settings::Motion::Singer, "singer"}},
+                                          "motion model")
           .def("constant_velocity"),
       ParamSpec::real("q", dim::accel_psd, "constant_velocity: spectral density of the white acceleration noise")
           .def("1 m2/s3")
@@ -46,11 +54,12 @@ inline std::vector<ParamSpec> param_specs() {
           .positive(),
       ParamSpec::real("singer_sigma", dim::acceleration, "singer: standard deviation sigma_m of the acceleration")
           .positive(),
-      ParamSpec::choice("range_rate", {"auto", "use", "ignore"},
-                        "use the 4th element (range rate): when present (auto), always (use), never (ignore)")
-          .def("auto"),
-      ParamSpec::choice("init", {"two_point", "explicit", "paper000"},
-                        "two-point differencing, the initial_* values, or paper 000's three-point P0 (§IV.2.1)")
+      range_rate_param(),
+      ParamSpec::choice<Settings::Init>("init",
+                                        {{Settings::Init::TwoPoint, "two_point"},
+                                         {Settings::Init::Explicit, "explicit"},
+                                         {Settings::Init::Paper000, "paper000"}},
+                                        "two-point differencing, the initial_* values, or paper 000's three-point P0 (§IV.2.1)")
           .def("two_point"),
       ParamSpec::real_list("initial_position", dim::length, "init explicit: position (ENU)", 3),
       ParamSpec::real_list("initial_velocity", dim::velocity, "init explicit: velocity", 3).def("[0, 0, 0]"),
@@ -70,10 +79,7 @@ inline Settings parse_settings(const Params& p, std::string type) {
   S s;
   s.type = std::move(type);
   s.node = p.node();
-  const std::string& motion = p.text("motion");
-  s.motion = motion == "constant_acceleration" ? S::Motion::ConstantAcceleration
-             : motion == "singer"              ? S::Motion::Singer
-                                               : S::Motion::ConstantVelocity;
+  s.motion = p.choice<S::Motion>("motion");
   const bool cv = s.motion == S::Motion::ConstantVelocity, ca = s.motion == S::Motion::ConstantAcceleration,
              singer = s.motion == S::Motion::Singer;
   if (!cv && p.given("q"))
@@ -100,11 +106,8 @@ inline Settings parse_settings(const Params& p, std::string type) {
     s.intensity = ca ? p.real("q_jerk") : p.real("q");
   }
 
-  const std::string& rr = p.text("range_rate");
-  s.range_rate = rr == "use" ? S::RangeRate::Use : rr == "ignore" ? S::RangeRate::Ignore : S::RangeRate::Auto;
-
-  const std::string& init = p.text("init");
-  s.init = init == "explicit" ? S::Init::Explicit : init == "paper000" ? S::Init::Paper000 : S::Init::TwoPoint;
+  s.range_rate = p.choice<RangeRateUse>("range_rate");
+  s.init = p.choice<S::Init>("init");
   const bool expl = s.init == S::Init::Explicit;
   for (const char* name : {"initial_position", "initial_velocity", "initial_acceleration", "initial_sigma_position",
                            "initial_sigma_velocity"})

@@ -219,9 +219,9 @@ TEST_CASE("filter.decoupled: wrong inputs and parameters are clear errors, and R
   auto* f = dynamic_cast<Filter*>(dkf.get());
   REQUIRE(f);
   const NoiseHandles h = f->noise();
-  REQUIRE(h.measurement_noise);
-  CHECK(std::string(h.measurement_space) == "cartesian_position");
-  CHECK(h.process_noise_count == 1);
+  REQUIRE(h.measurement.R);
+  CHECK(h.measurement.space == MeasurementSpace::CartesianPosition);
+  CHECK(h.process.count == 1);
 }
 
 TEST_CASE("a measurement noise that is not a covariance is refused with a warning, never a NaN") {

@@ -29,11 +29,16 @@ class ExtendedKalmanFilter final
  public:
   explicit ExtendedKalmanFilter(cartesian_filter::Settings s) : Base(std::move(s)) {}
 
+  static std::vector<std::string> counter_names() { return {"azimuth_dropped", "azimuth_deweighted"}; }
+
  private:
+  enum Counter { kAzimuthDropped, kAzimuthDeweighted };
+
   void on_start_run() { zenith_reported_ = false; }
+  void on_end_run_report() {}
 
   template <int M>
-  void update(const Measurement& m) {
+  bool correct(const Measurement& m) {
     using MatM = Eigen::Matrix<double, M, M>;
     const Vec3 d = Layout::position(x_) - m.sensor_position;
     const Vec3 v = Layout::velocity(x_);
@@ -42,18 +47,33 @@ class ExtendedKalmanFilter final
     if (sing == SphericalSingularity::AtSensor) {
       this->warn("predicted position at the sensor at t=" + std::to_string(m.time) +
                  " s: no direction to linearise about; measurement not used");
-      return;
+      return false;
     }
     const SphericalVec<M> z = m.value.template head<M>();
     SphericalVec<M> nu = spherical_residual<M>(z, spherical_measurement<M>(d, v, m.azimuth));
     MatM R = R_.topLeftCorner(M, M);
     Eigen::Matrix<double, M, N> H = Eigen::Matrix<double, M, N>::Zero();
     for (int k = 0; k < 6; ++k) H.col(idx_[k]) = J.col(k);
-    // Curvature of the angles over the predicted horizontal uncertainty (zenith_linearisation.hpp):
-    // negligible at ordinary ranges, it de-weights the azimuth smoothly as the target nears the
-    // zenith. When the zenith itself is within 3 sigma of the predicted horizontal position the
-    // azimuth may flip by pi and is dropped: zero row, zero innovation, R decorrelated (an
-    // infinitely uncertain azimuth; range, elevation and range rate still update).
+    if (this->settings().zenith == cartesian_filter::Settings::Zenith::Curvature) condition_near_zenith<M>(m, d, sing, H, nu, R);
+    MatM S;
+    double nis = 0.0;
+    if (joseph_update<N, M>(x_, P_, nu, H, R, S, nis)) {
+      this->template accept_update<M>(nu, S, nis);
+      return true;
+    }
+    this->warn("innovation covariance not positive definite at t=" + std::to_string(m.time) +
+               " s; measurement not used");
+    return false;
+  }
+
+  // Curvature of the angles over the predicted horizontal uncertainty (zenith_linearisation.hpp):
+  // negligible at ordinary ranges, it de-weights the azimuth smoothly as the target nears the
+  // zenith. When the zenith itself is within 3 sigma of the predicted horizontal position the
+  // azimuth may flip by pi and is dropped: zero row, zero innovation, R decorrelated (an
+  // infinitely uncertain azimuth; range, elevation and range rate still update).
+  template <int M>
+  void condition_near_zenith(const Measurement& m, const Vec3& d, SphericalSingularity sing,
+                             Eigen::Matrix<double, M, N>& H, SphericalVec<M>& nu, Eigen::Matrix<double, M, M>& R) {
     Eigen::Matrix2d Ph;
     Ph << P_(idx_[0], idx_[0]), P_(idx_[0], idx_[1]), P_(idx_[1], idx_[0]), P_(idx_[1], idx_[1]);
     const ekf::AngleCurvature curvature = ekf::angle_curvature_variance(d, Ph, kZenithFraction * d.norm());
@@ -66,29 +86,26 @@ class ExtendedKalmanFilter final
       R.row(1).setZero();
       R.col(1).setZero();
       R(1, 1) = raz > 0.0 ? raz : 1.0;
+      this->count(kAzimuthDropped);
     } else {
       R(1, 1) += curvature.azimuth;
+      if (curvature.azimuth > raz) this->count(kAzimuthDeweighted);
     }
     if (!zenith_reported_ && (drop_azimuth || curvature.azimuth > raz)) {
       this->warn("target near the zenith at t=" + std::to_string(m.time) + " s: azimuth " +
                  (drop_azimuth ? "not used" : "de-weighted") +
-                 " (its linearisation fails over the predicted uncertainty); reported once per run");
+                 " (its linearisation fails over the predicted uncertainty); counted in the summary, reported once "
+                 "per run");
       zenith_reported_ = true;
     }
-    MatM S;
-    double nis = 0.0;
-    if (joseph_update<N, M>(x_, P_, nu, H, R, S, nis))
-      this->template accept_update<M>(nu, S, nis);
-    else
-      this->warn("innovation covariance not positive definite at t=" + std::to_string(m.time) +
-                 " s; measurement not used");
   }
 
   bool zenith_reported_ = false;
 };
 
 std::unique_ptr<Component> create(const Params& p) {
-  const cartesian_filter::Settings s = cartesian_filter::parse_settings(p, "filter.ekf");
+  cartesian_filter::Settings s = cartesian_filter::parse_settings(p, "filter.ekf");
+  s.zenith = p.choice<cartesian_filter::Settings::Zenith>("zenith");
   if (s.order() == 2) return std::make_unique<ExtendedKalmanFilter<2>>(s);
   return std::make_unique<ExtendedKalmanFilter<3>>(s);
 }
@@ -105,11 +122,19 @@ void register_components(Registrar& r) {
       "corrected), azimuth innovation wrapped to (-pi, pi], Joseph-form update. Motion: CV (white acceleration, q), "
       "CA (Wiener-process acceleration, q_jerk, paper 000 eq 3.19), sigma_accel for the discrete white-noise "
       "variants, or Singer (alpha, sigma_m; exact discretisation). Near the zenith the angles' curvature variance is "
-      "added to R and the azimuth is dropped while the zenith is within 3 sigma. Invalid measurements: predict only. "
+      "added to R and the azimuth is dropped while the zenith is within 3 sigma (zenith: curvature; zenith: textbook "
+      "is the plain EKF); dropped and de-weighted azimuths are counted in the summary. Invalid measurements: predict "
+      "only. "
       "R from each measurement in spherical space (adapters may replace it; q per ENU axis). See docs/filters.md.";
   d.accepts = mask(ItemKind::Measurement);
   d.produces = mask(ItemKind::Estimate);
+  d.accepts_frames = mask(Frame::Spherical);
   d.params = cartesian_filter::param_specs();
+  using Zenith = cartesian_filter::Settings::Zenith;
+  d.params.push_back(ParamSpec::choice<Zenith>("zenith", {{Zenith::Curvature, "curvature"}, {Zenith::Textbook, "textbook"}},
+                                               "near the zenith: add the angles' curvature variance to R and drop the "
+                                               "azimuth within 3 sigma of it (curvature), or the textbook EKF (textbook)")
+                         .def("curvature"));
   d.create = create;
   r.add(std::move(d));
 }

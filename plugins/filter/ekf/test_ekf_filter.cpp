@@ -411,11 +411,11 @@ TEST_CASE("noise handles: R in spherical space, per-axis q that the prediction f
   auto* fb = dynamic_cast<Filter*>(b.filter.get());
   REQUIRE(fa);
   const NoiseHandles h = fb->noise();
-  CHECK(std::string(h.measurement_space) == "spherical");
-  REQUIRE(h.process_noise_count == 3);
-  CHECK(fa->noise().process_noise[0] == 1.0);
+  CHECK(h.measurement.space == MeasurementSpace::Spherical);
+  REQUIRE(h.process.count == 3);
+  CHECK(fa->noise().process.values[0] == 1.0);
   for (int k = 0; k < 5; ++k) {
-    if (k == 3) h.process_noise[0] = 100.0;  // an adapter raising q east after the first steps
+    if (k == 3) h.process.values[0] = 100.0;  // an adapter raising q east after the first steps
     const Measurement m = radar(k, Vec3(5e3 + 100.0 * k, 5e3, 500), Vec3(100, 0, 0), Vec3::Zero(), RadarNoise{}, nullptr, false);
     a.feed(m);
     b.feed(m);

@@ -2,6 +2,7 @@
 #include "spherical_ca_model.hpp"
 #include "spherical_two_point.hpp"
 
+#include <trackflow/filter_front_end.hpp>
 #include <trackflow/geometry.hpp>
 #include <trackflow/kalman.hpp>
 #include <trackflow/motion.hpp>
@@ -17,9 +18,11 @@ namespace {
 
 using namespace ekf_spherical;
 
+enum class Init { TwoPoint, Explicit };
+
 struct SphericalEkfSettings {
   double q[3] = {1.0, 1.0, 1.0};  // jerk PSD of the radial, horizontal and vertical channels, m2/s5
-  enum class RangeRate { Auto, Use, Ignore } range_rate = RangeRate::Auto;
+  RangeRateUse range_rate = RangeRateUse::Auto;
   bool two_point = true;
   State x0 = State::Zero();  // init explicit
   Matrix P0 = Matrix::Zero();
@@ -33,119 +36,61 @@ constexpr double kNearZenith = 80.0 * std::numbers::pi / 180.0;
 
 // The state is relative to one stationary sensor, in that sensor's azimuth convention: both are
 // fixed by the first measurement of a run.
-class SphericalEkf final : public Filter {
+class SphericalEkf final : public FilterFrontEnd<SphericalEkf> {
+  friend FilterFrontEnd<SphericalEkf>;
+
  public:
-  explicit SphericalEkf(SphericalEkfSettings s) : s_(std::move(s)) {
-    for (int i = 0; i < 3; ++i) q_[i] = s_.q[i];  // noise() may be read before the first run
-    R_ = MeasCov::Zero(3, 3);
+  explicit SphericalEkf(SphericalEkfSettings s)
+      : FilterFrontEnd(FrontEndSpec{"filter.ekf_spherical", s.node, Frame::Spherical, s.range_rate, {"azimuth_dropped"}}),
+        s_(std::move(s)) {
+    for (int i = 0; i < 3; ++i) q_[i] = s_.q[i];
     est_.state = State::Zero();
     est_.covariance = Matrix::Zero();
-    est_.enu.setZero();
-    est_.enu_covariance.setZero();
   }
 
   NoiseHandles noise() override {
     NoiseHandles h;
-    h.measurement_noise = &R_;
-    h.process_noise = q_;
-    h.process_noise_count = 3;  // q_r, q_h (θ channel), q_v (φ channel), all m2/s5
-    h.measurement_space = "spherical";
+    h.measurement = {&R_, MeasurementSpace::Spherical};
+    h.process = {q_, 3, NoiseKind::SpectralDensity, dim::jerk_psd, NoiseAxes::LineOfSight};  // q_r, q_h, q_v
     return h;
   }
 
-  void start_run(const RunContext& ctx) override {
-    diag_ = ctx.diagnostics;
-    // An adapter may have retuned q in this instance's previous run (which depends on the thread
-    // count): every run starts from the configured values.
-    for (int i = 0; i < 3; ++i) q_[i] = s_.q[i];
+  StateLayout state_layout() const override {
+    static constexpr StateComponent kLayout[] = {{"R", "m"},     {"v_r", "m/s"}, {"vdot_r", "m/s2"},
+                                                 {"theta", "rad"}, {"v_h", "m/s"}, {"vdot_h", "m/s2"},
+                                                 {"phi", "rad"},   {"v_v", "m/s"}, {"vdot_v", "m/s2"}};
+    return {kLayout, kDim};
+  }
+
+ private:
+  enum Counter { kAzimuthDropped };
+
+  bool reset_track() {
     points_ = 0;
-    has_time_ = false;
     has_sensor_ = false;
     last_T_ = -1.0;
     guard_steps_ = 0;
     predictions_ = 0;
     folds_ = 0;
-    azimuth_drops_ = 0;
-    initialised_ = !s_.two_point;
-    if (initialised_) {
+    if (!s_.two_point) {
       x_ = s_.x0;
       P_ = s_.P0;
     }
+    return !s_.two_point;
   }
 
-  std::unique_ptr<RunResult> end_run() override {
-    if (azimuth_drops_ > 0 && diag_)
-      diag_->warn(s_.node, "target near the zenith: azimuth not used in " + std::to_string(azimuth_drops_) +
-                           " updates (the vertical axis within 3 sigma of the predicted position)");
-    if (guard_steps_ > 0 && diag_)
-      diag_->warn(s_.node, "propagation guard (R < min_range or |elevation| > max_elevation) held the model's "
-                           "coefficients on " + std::to_string(guard_steps_) + " of " + std::to_string(predictions_) +
-                           " predictions, first at t=" + std::to_string(first_guard_time_) + " s; state folded over "
-                           "the zenith " + std::to_string(folds_) + " times; the spherical model is singular there "
-                           "(filter.ekf suits overhead passes)");
-    return nullptr;
+  void on_end_run() {
+    if (guard_steps_ > 0)
+      warn("propagation guard (R < min_range or |elevation| > max_elevation) held the model's coefficients on " +
+           std::to_string(guard_steps_) + " of " + std::to_string(predictions_) + " predictions, first at t=" +
+           std::to_string(first_guard_time_) + " s; state folded over the zenith " + std::to_string(folds_) +
+           " times; the spherical model is singular there (filter.ekf suits overhead passes)");
   }
 
-  void on_measurement(const Measurement& m, int) override {
-    if (m.frame != Frame::Spherical)
-      throw DataError("filter.ekf_spherical (node '" + s_.node +
-                      "') takes spherical [r, az, el(, rdot)] measurements; for Cartesian (converted) measurements "
-                      "use filter.kalman");
-    const int n = static_cast<int>(m.value.size());
-    const bool well_formed = n == (m.has_range_rate ? 4 : 3) && m.covariance.rows() == n && m.covariance.cols() == n;
-    if (m.valid && !well_formed)
-      throw DataError("filter.ekf_spherical (node '" + s_.node + "'): measurement at t=" + std::to_string(m.time) +
-                      " s has " + std::to_string(n) + " values and a " + std::to_string(m.covariance.rows()) + "x" +
-                      std::to_string(m.covariance.cols()) + " covariance; expected " +
-                      (m.has_range_rate ? "4 (r, az, el, rdot)" : "3 (r, az, el)"));
-    check_sensor(m);
-    if (has_time_ && m.time < time_) {
-      if (diag_)
-        diag_->skip(s_.node, "measurement at t=" + std::to_string(m.time) + " s is older than the track (t=" +
-                                 std::to_string(time_) + " s)");
-      return;
-    }
-    int dim = 3;
-    if (s_.range_rate == SphericalEkfSettings::RangeRate::Use) {
-      if (m.valid && !m.has_range_rate)
-        throw DataError("filter.ekf_spherical (node '" + s_.node + "'): range_rate: use, but the measurement at t=" +
-                        std::to_string(m.time) + " s has no range rate (range_rate: auto accepts both)");
-      dim = 4;
-    } else if (s_.range_rate == SphericalEkfSettings::RangeRate::Auto) {
-      dim = m.has_range_rate ? 4 : 3;
-    }
-    if (well_formed && n >= dim) R_ = m.covariance.topLeftCorner(dim, dim);
-    before_update(m);  // adapters may replace R_ and q_
-    if (m.valid && (R_.rows() < dim || R_.cols() < dim))
-      throw DataError("filter.ekf_spherical (node '" + s_.node + "'): an adapter left a " + std::to_string(R_.rows()) +
-                      "x" + std::to_string(R_.cols()) + " R for a " + std::to_string(dim) + "-element measurement");
-    const bool usable = m.valid && m.value.allFinite();
-    if (m.valid && !usable && diag_)
-      diag_->warn(s_.node, "non-finite measurement at t=" + std::to_string(m.time) + " s treated as invalid");
-    if (!initialised_) {
-      initialise(m, usable, dim);
-      return;
-    }
-    if (!has_time_) {  // explicit initial state: it holds at the first measurement's time
-      time_ = m.time;
-      has_time_ = true;
-    }
-    predict(m.time);
-    est_.updated = false;
-    est_.innovation.resize(0);
-    est_.innovation_covariance.resize(0, 0);
-    est_.nis = 0.0;
-    if (usable) {
-      if (dim == 4)
-        update<4>(m);
-      else
-        update<3>(m);
-    }
-    fill_estimate(m.time);
-    publish(m, est_);
-  }
+  void scale_state_covariance(double k) { P_ *= k; }
 
- private:
+  void check_measurement(const Measurement& m) { check_sensor(m); }
+
   // A spherical state means nothing once the origin or the azimuth reference changes.
   void check_sensor(const Measurement& m) {
     if (!has_sensor_) {
@@ -155,43 +100,39 @@ class SphericalEkf final : public Filter {
       return;
     }
     if (m.azimuth != convention_)
-      throw DataError("filter.ekf_spherical (node '" + s_.node + "'): measurement at t=" + std::to_string(m.time) +
+      throw DataError(who() + ": measurement at t=" + std::to_string(m.time) +
                       " s uses another azimuth convention than the track; the filter follows one sensor");
     if ((m.sensor_position - sensor_).norm() > 1e-6 * (1.0 + sensor_.norm()))
-      throw DataError("filter.ekf_spherical (node '" + s_.node + "'): measurement at t=" + std::to_string(m.time) +
+      throw DataError(who() + ": measurement at t=" + std::to_string(m.time) +
                       " s comes from another sensor position than the track's; the spherical state is relative to "
                       "one stationary sensor (use filter.ekf to fuse sensors)");
   }
 
-  void predict(double t) {
-    const double T = t - time_;
-    if (T > 0.0) {
-      if (T != last_T_) {  // fixed-rate data: the unit-intensity Q1 is computed once
-        unit_Q1_ = ConstantAcceleration::axis_noise_continuous(T, 1.0);
-        last_T_ = T;
-      }
-      const Coefficients c = coefficients(x_, s_.guard);
-      ++predictions_;
-      if (c.range_guarded || c.elevation_guarded) {
-        if (guard_steps_ == 0) first_guard_time_ = t;
-        ++guard_steps_;
-      }
-      jacobian(x_, T, s_.guard, F_);
-      process_noise(x_, unit_Q1_, q_, s_.guard, Q_);  // at the prior state, like F
-      propagate(x_, T, s_.guard);
-      x_(kTheta) = wrap_angle(x_(kTheta));
-      FP_.noalias() = F_ * P_;
-      P_.noalias() = FP_ * F_.transpose();
-      P_ += Q_;
-      P_ = (0.5 * (P_ + P_.transpose())).eval();
-      if (fold_over_zenith(x_, P_)) ++folds_;
+  void predict(double T) {
+    if (T != last_T_) {  // fixed-rate data: the unit-intensity Q1 is computed once
+      unit_Q1_ = ConstantAcceleration::axis_noise_continuous(T, 1.0);
+      last_T_ = T;
     }
-    time_ = t;
+    const Coefficients c = coefficients(x_, s_.guard);
+    ++predictions_;
+    if (c.range_guarded || c.elevation_guarded) {
+      if (guard_steps_ == 0) first_guard_time_ = time();
+      ++guard_steps_;
+    }
+    jacobian(x_, T, s_.guard, F_);
+    process_noise(x_, unit_Q1_, q_, s_.guard, Q_);  // at the prior state, like F
+    propagate(x_, T, s_.guard);
+    x_(kTheta) = wrap_angle(x_(kTheta));
+    FP_.noalias() = F_ * P_;
+    P_.noalias() = FP_ * F_.transpose();
+    P_ += Q_;
+    P_ = (0.5 * (P_ + P_.transpose())).eval();
+    if (fold_over_zenith(x_, P_)) ++folds_;
   }
 
   // Linear measurement (eq 3.61-3.63) in SDK order [r, az, el(, rdot)].
   template <int M>
-  void update(const Measurement& m) {
+  bool update(const Measurement& m) {
     using MatM = Eigen::Matrix<double, M, M>;
     Eigen::Matrix<double, M, kDim> H = Eigen::Matrix<double, M, kDim>::Zero();
     H(0, kR) = 1.0;
@@ -211,7 +152,7 @@ class SphericalEkf final : public Filter {
       R.row(1).setZero();
       R.col(1).setZero();
       R(1, 1) = raz > 0.0 ? raz : 1.0;
-      ++azimuth_drops_;
+      count(kAzimuthDropped);
     }
     if (std::abs(x_(kPhi)) > kNearZenith || std::abs(z(2)) > kNearZenith)
       nearer_representation<M>(H, drop_azimuth, z, R);
@@ -222,14 +163,11 @@ class SphericalEkf final : public Filter {
     if (joseph_update<kDim, M>(x_, P_, nu, H, R, S, nis)) {
       x_(kTheta) = wrap_angle(x_(kTheta));
       if (fold_over_zenith(x_, P_)) ++folds_;
-      est_.updated = true;
-      est_.innovation = nu;
-      est_.innovation_covariance = S;
-      est_.nis = nis;
-    } else if (diag_) {
-      diag_->warn(s_.node, "innovation covariance not positive definite at t=" + std::to_string(m.time) +
-                               " s; measurement not used");
+      accept_update<M>(nu, S, nis);
+      return true;
     }
+    warn("innovation covariance not positive definite at t=" + std::to_string(m.time) + " s; measurement not used");
+    return false;
   }
 
   // Horizontal range R_h = R cos φ against the std of the predicted position along the horizontal
@@ -271,15 +209,7 @@ class SphericalEkf final : public Filter {
   }
 
   // Two-point differencing in (r, θ, φ): spherical_two_point.hpp.
-  void initialise(const Measurement& m, bool usable, int dim) {
-    if (!usable) {
-      publish_uninitialised(m);
-      return;
-    }
-    if (points_ > 0 && m.time < t1_) {
-      if (diag_) diag_->skip(s_.node, "measurement at t=" + std::to_string(m.time) + " s is older than the previous one");
-      return;
-    }
+  bool initialise(const Measurement& m, int dim) {
     Meas4 z = Meas4::Zero();
     Cov4 R = Cov4::Zero();
     z.head(dim) = m.value.head(dim);
@@ -289,39 +219,23 @@ class SphericalEkf final : public Filter {
       R1_ = R;
       t1_ = m.time;
       points_ = 1;
-      publish_uninitialised(m);
-      return;
+      return false;
     }
     two_point_state(z1_, R1_, z, R, m.time - t1_, dim == 4, s_.sigma_accel, x_, P_);
     points_ = 2;
-    time_ = m.time;
-    has_time_ = true;
-    initialised_ = true;
-    est_.updated = false;
-    est_.innovation.resize(0);
-    est_.innovation_covariance.resize(0, 0);
-    est_.nis = 0.0;
-    fill_estimate(m.time);
-    publish(m, est_);
-  }
-
-  void publish_uninitialised(const Measurement& m) {
-    set_uninitialised(est_, m.time);
-    publish(m, est_);
+    return true;
   }
 
   // ENU block for metrics: p = sensor + R e_r, v = v_r e_r + v_h e_θ + v_v e_φ, cov J P J'.
-  void fill_estimate(double t) {
-    est_.time = t;
-    est_.initialised = true;
-    est_.state = x_;
-    est_.covariance = P_;
-    est_.enu = to_enu(x_, convention_, &J_enu_);
-    est_.enu.head<3>() += sensor_;
+  void fill_estimate(Estimate& e) {
+    e.state = x_;
+    e.covariance = P_;
+    e.enu = to_enu(x_, convention_, &J_enu_);
+    e.enu.head<3>() += sensor_;
     JP_.noalias() = J_enu_ * P_;
     Mat6 C;
     C.noalias() = JP_ * J_enu_.transpose();
-    est_.enu_covariance = 0.5 * (C + C.transpose());
+    e.enu_covariance = 0.5 * (C + C.transpose());
   }
 
   SphericalEkfSettings s_;
@@ -331,18 +245,15 @@ class SphericalEkf final : public Filter {
   Eigen::Matrix3d unit_Q1_ = Eigen::Matrix3d::Zero();
   EnuJacobian J_enu_ = EnuJacobian::Zero();
   Eigen::Matrix<double, 6, kDim> JP_ = Eigen::Matrix<double, 6, kDim>::Zero();
-  MeasCov R_;
-  Estimate est_;
-  Diagnostics* diag_ = nullptr;
-  double time_ = 0.0, last_T_ = -1.0;
-  bool has_time_ = false, initialised_ = false, has_sensor_ = false;
+  double last_T_ = -1.0;
+  bool has_sensor_ = false;
   Vec3 sensor_ = Vec3::Zero();
   AzimuthConvention convention_ = AzimuthConvention::NorthClockwise;
   int points_ = 0;
   Meas4 z1_ = Meas4::Zero();
   Cov4 R1_ = Cov4::Zero();
   double t1_ = 0.0;
-  long long guard_steps_ = 0, predictions_ = 0, folds_ = 0, azimuth_drops_ = 0;
+  long long guard_steps_ = 0, predictions_ = 0, folds_ = 0;
   double first_guard_time_ = 0.0;
 };
 
@@ -353,11 +264,10 @@ std::unique_ptr<Component> create(const Params& p) {
   s.q[0] = p.real("q_r");
   s.q[1] = p.real("q_h");
   s.q[2] = p.real("q_v");
-  const std::string& rr = p.text("range_rate");
-  s.range_rate = rr == "use" ? S::RangeRate::Use : rr == "ignore" ? S::RangeRate::Ignore : S::RangeRate::Auto;
+  s.range_rate = p.choice<RangeRateUse>("range_rate");
   s.guard.max_elevation = p.real("max_elevation");
   s.guard.min_range = p.real("min_range");
-  s.two_point = p.text("init") == "two_point";
+  s.two_point = p.choice<Init>("init") == Init::TwoPoint;
   const char* explicit_only[] = {"initial_range",        "initial_azimuth",        "initial_elevation",
                                  "initial_velocity",     "initial_acceleration",   "initial_sigma_range",
                                  "initial_sigma_angle",  "initial_sigma_velocity"};
@@ -399,6 +309,7 @@ void register_components(Registrar& r) {
       "position/velocity with J P J'. The model is singular overhead and at the sensor: its coefficients are held at "
       "max_elevation / min_range there (warning per run). Invalid measurements: predict only. See docs/filters.md.";
   d.accepts = mask(ItemKind::Measurement);
+  d.accepts_frames = mask(Frame::Spherical);
   d.produces = mask(ItemKind::Estimate);
   d.params = {
       ParamSpec::real("q_r", dim::jerk_psd, "jerk PSD of the radial channel [R, v_r, v̇_r] (paper 000 eq 3.58, q_r)")
@@ -412,10 +323,9 @@ void register_components(Registrar& r) {
                       "jerk PSD of the vertical cross-range channel [φ, v_v, v̇_v] (paper's q_φ, as a linear PSD)")
           .def("1 m2/s5")
           .at_least(0),
-      ParamSpec::choice("range_rate", {"auto", "use", "ignore"},
-                        "use the 4th element (range rate): when present (auto), always (use), never (ignore)")
-          .def("auto"),
-      ParamSpec::choice("init", {"two_point", "explicit"}, "two-point differencing in (r, az, el) or the initial_* values")
+      range_rate_param(),
+      ParamSpec::choice<Init>("init", {{Init::TwoPoint, "two_point"}, {Init::Explicit, "explicit"}},
+                              "two-point differencing in (r, az, el) or the initial_* values")
           .def("two_point"),
       ParamSpec::real("initial_range", dim::length, "init explicit: range R").positive(),
       ParamSpec::real("initial_azimuth", dim::angle, "init explicit: azimuth θ in the measurements' convention"),

@@ -393,20 +393,20 @@ TEST_CASE("noise handles: spherical R, three jerk intensities, and a change take
     Track k;
     k.start();
     const NoiseHandles h = k.f->noise();
-    CHECK(h.process_noise_count == 3);
-    CHECK(std::string(h.measurement_space) == "spherical");
+    CHECK(h.process.count == 3);
+    CHECK(h.measurement.space == MeasurementSpace::Spherical);
     Rng rng(2);
     const Vec3 v(100, 0, 0), p0(0, 30e3, 2e3);
     for (int i = 0; i < 20; ++i)
       k.c->on_measurement(radar(i, Vec3::Zero(), p0 + v * i, v, Noise{}, false, AzimuthConvention::NorthClockwise,
                                 rng), 0);
-    CHECK(h.measurement_noise->rows() == 3);
-    h.process_noise[1] = qh_after;
+    CHECK(h.measurement.R->rows() == 3);
+    h.process.values[1] = qh_after;
     k.c->on_measurement(radar(20, Vec3::Zero(), p0 + v * 20, v, Noise{}, false, AzimuthConvention::NorthClockwise,
                               rng), 0);
     const double var_ah = k.out.estimates.back().covariance(es::kAh, es::kAh);
     k.start(1);  // the next run starts from the configured q whatever an adapter left
-    CHECK(h.process_noise[1] == 1.0);
+    CHECK(h.process.values[1] == 1.0);
     return var_ah;
   };
   CHECK(run(100.0) > 2 * run(1.0));

@@ -1,6 +1,7 @@
 // Purpose: filter.gain_transform — paper 002's gain-transformation filter: Cartesian Singer state, polar [r, az, el] measurements, gains of three decoupled LOS-frame filters rotated to ENU.
 #include "gain_transform_core.hpp"
 
+#include <trackflow/filter_front_end.hpp>
 #include <trackflow/geometry.hpp>
 #include <trackflow/motion.hpp>
 #include <trackflow/plugin.hpp>
@@ -14,6 +15,8 @@ namespace {
 
 using namespace gain_transform;
 
+enum class FrameChange { Reproject, Carry };
+
 struct GainTransformSettings {
   double alpha = 1.0;          // Singer inverse correlation time, 1/s, the same on all axes
   double sigma = 1.0;          // Singer sigma_m, m/s2 (per ENU axis, adapters may retune each)
@@ -26,102 +29,63 @@ struct GainTransformSettings {
 // position, the azimuth can flip by pi over the uncertainty and is not used (as filter.ekf).
 constexpr double kZenithSigmas = 3.0;
 
-class GainTransformFilter final : public Filter {
+// The measurement front end is the SDK's (filter_front_end.hpp); this class is the model.
+class GainTransformFilter final : public FilterFrontEnd<GainTransformFilter> {
+  friend FilterFrontEnd<GainTransformFilter>;
+
  public:
-  explicit GainTransformFilter(GainTransformSettings s) : s_(std::move(s)) {
+  explicit GainTransformFilter(GainTransformSettings s)
+      : FilterFrontEnd(FrontEndSpec{"filter.gain_transform", s.node, Frame::Spherical, RangeRateUse::Ignore, {"azimuth_dropped"}}),
+        s_(std::move(s)) {
     for (double& q : q_) q = s_.sigma;
     est_.state.resize(9);
     est_.covariance.resize(9, 9);
-    R_ = MeasCov::Zero(3, 3);
   }
 
   NoiseHandles noise() override {
     NoiseHandles h;
-    h.measurement_noise = &R_;
-    h.process_noise = q_;
-    h.process_noise_count = 3;  // Singer sigma_m east, north, up
-    h.measurement_space = "spherical";
+    h.measurement = {&R_, MeasurementSpace::Spherical};
+    h.process = {q_, 3, NoiseKind::StandardDeviation, dim::acceleration, NoiseAxes::Enu};  // Singer sigma_m
     return h;
   }
 
-  void start_run(const RunContext& ctx) override {
-    // Adapters may have retuned sigma_m in the previous run on this instance.
-    for (double& q : q_) q = s_.sigma;
-    diag_ = ctx.diagnostics;
-    points_ = 0;
-    last_T_ = -1.0;
-    has_time_ = false;
-    initialised_ = false;
-    zenith_reported_ = false;
-  }
-
-  void on_measurement(const Measurement& m, int) override {
-    if (m.frame != Frame::Spherical)
-      throw DataError("filter.gain_transform (node '" + s_.node +
-                      "') takes spherical [r, az, el] measurements; for converted Cartesian measurements use "
-                      "filter.decoupled or filter.kalman");
-    const int n = static_cast<int>(m.value.size());
-    const bool well_formed =
-        n == (m.has_range_rate ? 4 : 3) && m.covariance.rows() == n && m.covariance.cols() == n;
-    if (m.valid && !well_formed)
-      throw DataError("filter.gain_transform (node '" + s_.node + "'): measurement at t=" + std::to_string(m.time) +
-                      " s has " + std::to_string(n) + " values and a " + std::to_string(m.covariance.rows()) + "x" +
-                      std::to_string(m.covariance.cols()) + " covariance; expected " +
-                      (m.has_range_rate ? "4 (r, az, el, rdot)" : "3 (r, az, el)"));
-    if (has_time_ && m.time < time_) {
-      if (diag_)
-        diag_->skip(s_.node, "measurement at t=" + std::to_string(m.time) + " s is older than the track (t=" +
-                                 std::to_string(time_) + " s)");
-      return;
-    }
-    // The range rate, when present, is not used (paper 002 measures [r, az, el]).
-    if (well_formed) R_ = m.covariance.topLeftCorner(3, 3);
-    before_update(m);  // adapters may replace R_ and q_
-    if (m.valid && (R_.rows() != 3 || R_.cols() != 3))
-      throw DataError("filter.gain_transform (node '" + s_.node + "'): an adapter left a " +
-                      std::to_string(R_.rows()) + "x" + std::to_string(R_.cols()) + " R; expected 3x3 (r, az, el)");
-    const bool usable = m.valid && m.value.head<3>().allFinite();
-    if (m.valid && !usable && diag_)
-      diag_->warn(s_.node, "non-finite measurement at t=" + std::to_string(m.time) + " s treated as invalid");
-    if (!initialised_) {
-      initialise(m, usable);
-      return;
-    }
-    predict(m.time);
-    est_.updated = false;
-    est_.innovation.resize(0);
-    est_.innovation_covariance.resize(0, 0);
-    est_.nis = 0.0;
-    if (usable) update(m);
-    fill_estimate(m.time);
-    publish(m, est_);
-  }
+  StateLayout state_layout() const override { return ConstantAcceleration::state_layout(); }
 
  private:
-  void predict(double t) {
-    const double T = t - time_;
-    if (T > 0.0) {
-      if (T != last_T_) {  // fixed-rate data: F and the unit-sigma Q are computed once
-        const Eigen::Matrix3d F = SingerModel::axis_transition(s_.alpha, T);
-        const Eigen::Matrix3d Q = (2.0 * s_.alpha) * SingerModel::noise_per_psd(s_.alpha, T);
-        model_ = {F(0, 1), F(0, 2), F(1, 2), F(2, 2), {Q(0, 0), Q(0, 1), Q(0, 2), Q(1, 1), Q(1, 2), Q(2, 2)}};
-        last_T_ = T;
-      }
-      predict_state(x_, model_);
-      // Q in the LOS frame is (D' diag(sigma_a^2) D) ⊗ Q1; with one sigma_m on all axes it is
-      // sigma^2 I ⊗ Q1 in every frame (exact). Per-axis values (an adapter) keep its diagonal.
-      double s2[3];
-      if (q_[0] == q_[1] && q_[1] == q_[2]) {
-        s2[0] = s2[1] = s2[2] = q_[0] * q_[0];
-      } else {
-        for (int i = 0; i < 3; ++i) {
-          s2[i] = 0.0;
-          for (int a = 0; a < 3; ++a) s2[i] += frame_.u[i][a] * frame_.u[i][a] * q_[a] * q_[a];
-        }
-      }
-      for (int i = 0; i < 3; ++i) predict_axis(B_[i], model_, s2[i]);
+  enum Counter { kAzimuthDropped };
+
+  bool reset_track() {
+    points_ = 0;
+    last_T_ = -1.0;
+    has_frame_ = false;
+    zenith_reported_ = false;
+    return false;
+  }
+
+  void predict(double T) {
+    if (T != last_T_) {  // fixed-rate data: F and the unit-sigma Q are computed once
+      const Eigen::Matrix3d F = SingerModel::axis_transition(s_.alpha, T);
+      const Eigen::Matrix3d Q = (2.0 * s_.alpha) * SingerModel::noise_per_psd(s_.alpha, T);
+      model_ = {F(0, 1), F(0, 2), F(1, 2), F(2, 2), {Q(0, 0), Q(0, 1), Q(0, 2), Q(1, 1), Q(1, 2), Q(2, 2)}};
+      last_T_ = T;
     }
-    time_ = t;
+    predict_state(x_, model_);
+    // Q in the LOS frame is (D' diag(sigma_a^2) D) ⊗ Q1; with one sigma_m on all axes it is
+    // sigma^2 I ⊗ Q1 in every frame (exact). Per-axis values (an adapter) keep its diagonal.
+    double s2[3];
+    if (q_[0] == q_[1] && q_[1] == q_[2]) {
+      s2[0] = s2[1] = s2[2] = q_[0] * q_[0];
+    } else {
+      for (int i = 0; i < 3; ++i) {
+        s2[i] = 0.0;
+        for (int a = 0; a < 3; ++a) s2[i] += frame_.u[i][a] * frame_.u[i][a] * q_[a] * q_[a];
+      }
+    }
+    for (int i = 0; i < 3; ++i) predict_axis(B_[i], model_, s2[i]);
+  }
+
+  void scale_state_covariance(double k) {
+    for (auto& B : B_) B = {k * B.pp, k * B.pv, k * B.pa, k * B.vv, k * B.va, k * B.aa};
   }
 
   // The LOS frame at relative position d. Straight above the sensor the azimuth axis is
@@ -146,13 +110,13 @@ class GainTransformFilter final : public Filter {
     return true;
   }
 
-  void update(const Measurement& m) {
+  template <int M>
+  bool update(const Measurement& m) {
     const Vec3 d = Vec3(x_[state_index(0, 0)], x_[state_index(1, 0)], x_[state_index(2, 0)]) - m.sensor_position;
     if (!(d.norm() >= kMinRange)) {
-      if (diag_)
-        diag_->warn(s_.node, "predicted position at the sensor at t=" + std::to_string(m.time) +
-                                 " s: no line of sight to decouple along; measurement not used");
-      return;
+      warn("predicted position at the sensor at t=" + std::to_string(m.time) +
+           " s: no line of sight to decouple along; measurement not used");
+      return false;
     }
     azimuth_ = m.azimuth;
     LosFrame<double> next;
@@ -167,15 +131,15 @@ class GainTransformFilter final : public Filter {
     const bool use[3] = {true, !drop_azimuth, true};
     for (int i = 0; i < 3; ++i)
       if (use[i] && (!(rbar[i] >= 0.0) || !(B_[i].pp + rbar[i] > 0.0) || !std::isfinite(rbar[i]))) {
-        if (diag_)
-          diag_->warn(s_.node, "measurement variance not usable (negative or non-finite) at t=" +
-                                   std::to_string(m.time) + " s; measurement not used");
-        return;
+        warn("measurement variance not usable (negative or non-finite) at t=" + std::to_string(m.time) +
+             " s; measurement not used");
+        return false;
       }
-    if (drop_azimuth && !zenith_reported_ && diag_) {
-      diag_->warn(s_.node, "target near the zenith at t=" + std::to_string(m.time) +
-                               " s: azimuth not used (its linearisation fails over the predicted uncertainty); "
-                               "reported once per run");
+    if (drop_azimuth) count(kAzimuthDropped);
+    if (drop_azimuth && !zenith_reported_) {
+      warn("target near the zenith at t=" + std::to_string(m.time) +
+           " s: azimuth not used (its linearisation fails over the predicted uncertainty); counted in the summary, "
+           "reported once per run");
       zenith_reported_ = true;
     }
     const SphericalVec<3> z = m.value.head<3>();
@@ -185,12 +149,11 @@ class GainTransformFilter final : public Filter {
     decoupled_gain(B_, frame_, rbar, use, result_);
     correct_state(x_, frame_, nu_polar, use, result_);
 
-    est_.updated = true;
-    est_.innovation = nu;
-    est_.innovation_covariance = MeasCov::Zero(3, 3);
-    for (int i = 0; i < 3; ++i) est_.innovation_covariance(i, i) = result_.s[i] / (frame_.scale[i] * frame_.scale[i]);
-    if (drop_azimuth) est_.innovation_covariance(1, 1) = R_(1, 1) > 0.0 ? R_(1, 1) : 1.0;
-    est_.nis = result_.nis;
+    Mat3 S = Mat3::Zero();
+    for (int i = 0; i < 3; ++i) S(i, i) = result_.s[i] / (frame_.scale[i] * frame_.scale[i]);
+    if (drop_azimuth) S(1, 1) = R_(1, 1) > 0.0 ? R_(1, 1) : 1.0;
+    accept_update<3>(nu, S, result_.nis);
+    return true;
   }
 
   // Paper 002 §4 2): the state from the first two measurements (position = the second converted
@@ -198,15 +161,7 @@ class GainTransformFilter final : public Filter {
   // lines swapped), acceleration 0 with variance initial_sigma_acceleration^2. The covariance is
   // two-point differencing (Bar-Shalom, Li & Kirubarajan 2001 §5.5.3) per LOS axis of the
   // second point's frame, where its converted covariance is diagonal.
-  void initialise(const Measurement& m, bool usable) {
-    if (!usable) {
-      publish_uninitialised(m);
-      return;
-    }
-    if (points_ > 0 && m.time < tc_[points_ - 1]) {
-      if (diag_) diag_->skip(s_.node, "measurement at t=" + std::to_string(m.time) + " s is older than the previous one");
-      return;
-    }
+  bool initialise(const Measurement& m, int) {
     if (points_ > 0 && m.time == tc_[points_ - 1]) --points_;  // same time stamp: keep the newer one
     const double r = m.value(0), az = m.value(1), el = m.value(2);
     const Mat3 J = spherical_to_enu_jacobian(r, az, el, m.azimuth);
@@ -215,10 +170,7 @@ class GainTransformFilter final : public Filter {
     Rc_[points_] = 0.5 * (Rc + Rc.transpose());
     tc_[points_] = m.time;
     ++points_;
-    if (points_ < 2) {
-      publish_uninitialised(m);
-      return;
-    }
+    if (points_ < 2) return false;
     const double T = tc_[1] - tc_[0];
     azimuth_ = m.azimuth;
     has_frame_ = false;
@@ -234,34 +186,19 @@ class GainTransformFilter final : public Filter {
       const double r1 = u.dot(Rc_[0] * u), r2 = u.dot(Rc_[1] * u);
       B_[i] = {r2, r2 / T, 0.0, (r1 + r2) / (T * T), 0.0, s_.sigma_accel0 * s_.sigma_accel0};
     }
-    time_ = m.time;
-    has_time_ = true;
-    initialised_ = true;
-    est_.updated = false;
-    est_.innovation.resize(0);
-    est_.innovation_covariance.resize(0, 0);
-    est_.nis = 0.0;
-    fill_estimate(m.time);
-    publish(m, est_);
-  }
-
-  void publish_uninitialised(const Measurement& m) {
-    set_uninitialised(est_, m.time);
-    publish(m, est_);
+    return true;
   }
 
   // The published covariance is blkdiag(D) P̄ blkdiag(D)' (enu_covariance()): the ENU covariance
   // the decoupled blocks stand for, in motion.hpp's layout like filter.ekf's Singer state.
-  void fill_estimate(double t) {
-    est_.time = t;
-    est_.initialised = true;
-    for (int i = 0; i < 9; ++i) est_.state(i) = x_[i];
-    enu_covariance(B_, frame_.u, est_.covariance);
+  void fill_estimate(Estimate& e) const {
+    for (int i = 0; i < 9; ++i) e.state(i) = x_[i];
+    enu_covariance(B_, frame_.u, e.covariance);
     constexpr int kIndex[6] = {state_index(0, 0), state_index(1, 0), state_index(2, 0),
                                state_index(0, 1), state_index(1, 1), state_index(2, 1)};
     for (int i = 0; i < 6; ++i) {
-      est_.enu(i) = x_[kIndex[i]];
-      for (int j = 0; j < 6; ++j) est_.enu_covariance(i, j) = est_.covariance(kIndex[i], kIndex[j]);
+      e.enu(i) = x_[kIndex[i]];
+      for (int j = 0; j < 6; ++j) e.enu_covariance(i, j) = e.covariance(kIndex[i], kIndex[j]);
     }
   }
 
@@ -273,11 +210,8 @@ class GainTransformFilter final : public Filter {
   SingerAxis<double> model_ = {};
   UpdateResult<double> result_ = {};
   AzimuthConvention azimuth_ = AzimuthConvention::NorthClockwise;
-  MeasCov R_;
-  Estimate est_;
-  Diagnostics* diag_ = nullptr;
-  double time_ = 0.0, last_T_ = -1.0;
-  bool has_time_ = false, initialised_ = false, has_frame_ = false, zenith_reported_ = false;
+  double last_T_ = -1.0;
+  bool has_frame_ = false, zenith_reported_ = false;
   int points_ = 0;
   Vec3 zc_[2];
   Mat3 Rc_[2];
@@ -290,7 +224,7 @@ std::unique_ptr<Component> create(const Params& p) {
   s.alpha = p.real("singer_alpha");
   s.sigma = p.real("singer_sigma");
   s.sigma_accel0 = p.real_or("initial_sigma_acceleration", s.sigma);
-  s.reproject = p.text("frame_change") == "reproject";
+  s.reproject = p.choice<FrameChange>("frame_change") == FrameChange::Reproject;
   return std::make_unique<GainTransformFilter>(s);
 }
 
@@ -311,8 +245,9 @@ void register_components(Registrar& r) {
       "with the cos el the paper omits). Innovation in [r, az, el] with the azimuth wrapped to (-pi, pi]; the range "
       "rate, if present, is ignored. Published covariance: blkdiag(D) P0 blkdiag(D)'. Two-point initialisation "
       "from the first two measurements. Invalid measurements: predict only. R (spherical) and sigma_m per ENU axis "
-      "exposed to adapters. See docs/filters.md.";
+      "exposed to adapters; dropped azimuths are counted in the summary. See docs/filters.md.";
   d.accepts = mask(ItemKind::Measurement);
+  d.accepts_frames = mask(Frame::Spherical);
   d.produces = mask(ItemKind::Estimate);
   d.params = {
       ParamSpec::real("singer_alpha", dim::frequency,
@@ -325,7 +260,7 @@ void register_components(Registrar& r) {
       ParamSpec::real("initial_sigma_acceleration", dim::acceleration,
                       "initial acceleration std (default: singer_sigma, the stationary prior)")
           .positive(),
-      ParamSpec::choice("frame_change", {"reproject", "carry"},
+      ParamSpec::choice<FrameChange>("frame_change", {{FrameChange::Reproject, "reproject"}, {FrameChange::Carry, "carry"}},
                         "when the line of sight turns: re-express the LOS covariance blocks in the new frame, or "
                         "carry them unchanged (the paper's equations)")
           .def("reproject"),

@@ -358,18 +358,18 @@ TEST_CASE("noise handles: spherical R and per-axis sigma_m that the prediction f
   auto* fb = dynamic_cast<Filter*>(b.filter.get());
   REQUIRE(fb);
   const NoiseHandles h = fb->noise();
-  CHECK(std::string(h.measurement_space) == "spherical");
-  REQUIRE(h.process_noise_count == 3);
-  CHECK(h.process_noise[2] == 20.0);
-  REQUIRE(h.measurement_noise);
+  CHECK(h.measurement.space == MeasurementSpace::Spherical);
+  REQUIRE(h.process.count == 3);
+  CHECK(h.process.values[2] == 20.0);
+  REQUIRE(h.measurement.R);
   for (int k = 0; k < 20; ++k) {
-    if (k == 10) h.process_noise[2] = 200.0;  // an adapter raising sigma_m up
+    if (k == 10) h.process.values[2] = 200.0;  // an adapter raising sigma_m up
     const Measurement m = radar(k * kT, circle_position(k * kT), Vec3::Zero(), nullptr);
     a.feed(m);
     b.feed(m);
   }
-  CHECK(h.measurement_noise->rows() == 3);
-  CHECK((*h.measurement_noise)(0, 0) == Approx(kSigmaRange * kSigmaRange));
+  CHECK(h.measurement.R->rows() == 3);
+  CHECK((*h.measurement.R)(0, 0) == Approx(kSigmaRange * kSigmaRange));
   const auto& ea = a.out.estimates.back();
   const auto& eb = b.out.estimates.back();
   CHECK(eb.covariance(8, 8) > 10 * ea.covariance(8, 8));   // up acceleration

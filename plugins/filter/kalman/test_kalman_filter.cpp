@@ -227,36 +227,52 @@ TEST_CASE("a process-noise change through noise() takes effect at the next step 
     Diagnostics d;
     f.start_run({0, 1, &d});
     for (int k = 0; k < 10; ++k) f.on_measurement(cartesian(k, Vec3(k, 0, 0), 1), 0);
-    *f.noise().process_noise = q_after;
+    *f.noise().process.values = q_after;
     f.on_measurement(cartesian(10, Vec3(10, 0, 0), 1), 0);
     return out.estimates.back().enu_covariance(3, 3);
   };
   CHECK(run(100.0) > 2 * run(1.0));
 }
 
-TEST_CASE("grades set on the filter are carried by the next published estimate") {
+TEST_CASE("annotations an adapter sets are carried by the next published estimates") {
+  struct Annotator : Adapter {
+    std::vector<std::string> annotation_names() const override { return {"a", "b", "c"}; }
+    void before_update(const Measurement& m, Filter& f) override {
+      if (m.time >= 1.0) {
+        annotate(f, 0, 2.0);
+        annotate(f, 2, 0.0);
+      }
+    }
+  } annotator;
   auto c = test::make("filter.kalman");
   auto& f = dynamic_cast<Filter&>(*c);
+  REQUIRE(f.attach(&annotator, 3));
   test::Collector out;
   out.attach_to(f);
   Diagnostics d;
+  f.reset_adapted_state();
   f.start_run({0, 1, &d});
   f.on_measurement(cartesian(0, Vec3(1, 2, 3), 1), 0);
-  CHECK(out.estimates.back().quality[0] == -1);
-  f.set_quality(0, 2);
-  f.set_quality(2, 0);
+  REQUIRE(out.estimates.back().annotation_count == 3);
+  for (int i = 0; i < 3; ++i) CHECK(std::isnan(out.estimates.back().annotations[i]));
   f.on_measurement(cartesian(1, Vec3(1, 2, 3), 1), 0);
-  CHECK(out.estimates.back().quality[0] == 2);
-  CHECK(out.estimates.back().quality[1] == -1);
-  CHECK(out.estimates.back().quality[2] == 0);
+  CHECK(out.estimates.back().annotations[0] == 2.0);
+  CHECK(std::isnan(out.estimates.back().annotations[1]));
+  CHECK(out.estimates.back().annotations[2] == 0.0);
+  f.reset_adapted_state();  // the engine, at the next run
+  f.start_run({1, 1, &d});
+  f.on_measurement(cartesian(0, Vec3(1, 2, 3), 1), 0);
+  CHECK(std::isnan(out.estimates.back().annotations[0]));
 }
 
-TEST_CASE("a process noise retuned by an adapter does not leak into the next run") {
+TEST_CASE("a process noise retuned by an adapter is restored by the engine before the next run") {
   auto c = test::make("filter.kalman", "{ q: 1 m2/s3 }");
   auto& f = dynamic_cast<Filter&>(*c);
+  f.save_configured_noise();  // the engine, once the instance is built
   Diagnostics d;
   f.start_run({0, 1, &d});
-  *f.noise().process_noise = 50.0;
+  *f.noise().process.values = 50.0;
+  f.reset_adapted_state();  // the engine, at the start of every run
   f.start_run({1, 1, &d});
-  CHECK(*f.noise().process_noise == 1.0);
+  CHECK(*f.noise().process.values == 1.0);
 }

@@ -514,11 +514,11 @@ TEST_CASE("UKF coasts on invalid measurements, skips old ones, exposes its noise
   auto* f = dynamic_cast<Filter*>(run.filter.get());
   REQUIRE(f);
   const NoiseHandles h = f->noise();
-  CHECK(std::string(h.measurement_space) == "spherical");
-  CHECK(h.process_noise_count == 3);
-  CHECK(h.process_noise[0] == 1.0);
-  REQUIRE(h.measurement_noise);
-  CHECK((*h.measurement_noise)(0, 0) == Approx(100.0));
+  CHECK(h.measurement.space == MeasurementSpace::Spherical);
+  CHECK(h.process.count == 3);
+  CHECK(h.process.values[0] == 1.0);
+  REQUIRE(h.measurement.R);
+  CHECK((*h.measurement.R)(0, 0) == Approx(100.0));
 }
 
 TEST_CASE("UKF parameter errors are clear") {

@@ -41,7 +41,15 @@ class UnscentedKalmanFilter final
   UnscentedKalmanFilter(cartesian_filter::Settings s, UnscentedSettings u)
       : Base(std::move(s)), weights_(ukf::ScaledWeights::make(N, u.alpha, u.beta, u.kappa)) {}
 
-  std::unique_ptr<RunResult> end_run() override {
+  static std::vector<std::string> counter_names() { return {}; }
+
+ private:
+  void on_start_run() {
+    jitter_count_ = spread_clamped_count_ = updates_ = 0;
+    max_jitter_ = 0.0;
+  }
+
+  void on_end_run_report() {
     // Numerical repairs are counted rather than reported at every step.
     if (jitter_count_ > 0) {
       char buf[48];
@@ -55,24 +63,18 @@ class UnscentedKalmanFilter final
                  " made R plus the unscented spread indefinite (P - K S K' could lose definiteness) at " +
                  std::to_string(spread_clamped_count_) + " of " + std::to_string(updates_) +
                  " updates; its negative part was removed there (see alpha, beta, kappa)");
-    return nullptr;
   }
 
- private:
-  void on_start_run() {
-    jitter_count_ = spread_clamped_count_ = updates_ = 0;
-    max_jitter_ = 0.0;
-  }
 
   template <int M>
-  void update(const Measurement& m) {
+  bool correct(const Measurement& m) {
     using MatM = Eigen::Matrix<double, M, M>;
     ++updates_;
     const double jitter = ukf::guarded_cholesky<N>(P_, llt_);
     if (jitter < 0.0) {
       this->warn("state covariance at t=" + std::to_string(m.time) +
                  " s cannot be factored for sigma points; measurement not used");
-      return;
+      return false;
     }
     if (jitter > 0.0) {
       ++jitter_count_;
@@ -106,11 +108,13 @@ class UnscentedKalmanFilter final
     }
     MatM S;
     double nis = 0.0;
-    if (joseph_update<N, M>(x_, P_, nu, ut.H, R, S, nis))
+    if (joseph_update<N, M>(x_, P_, nu, ut.H, R, S, nis)) {
       this->template accept_update<M>(nu, S, nis);
-    else
-      this->warn("innovation covariance not positive definite at t=" + std::to_string(m.time) +
-                 " s; measurement not used");
+      return true;
+    }
+    this->warn("innovation covariance not positive definite at t=" + std::to_string(m.time) +
+               " s; measurement not used");
+    return false;
   }
 
   ukf::ScaledWeights weights_;
@@ -152,6 +156,7 @@ void register_components(Registrar& r) {
       "fourth moment, Julier & Uhlmann 2004) and non-negative covariance weights for n <= 9. See docs/filters.md.";
   d.accepts = mask(ItemKind::Measurement);
   d.produces = mask(ItemKind::Estimate);
+  d.accepts_frames = mask(Frame::Spherical);
   d.params = cartesian_filter::param_specs();
   d.params.push_back(ParamSpec::real("alpha", dim::none,
                                      "spread of the sigma points (scaled UT); 1 keeps them at sqrt(n + kappa) sigma, "

@@ -22,15 +22,11 @@ const char* const kConstantParams[] = {"sigma_range", "sigma_azimuth", "sigma_el
 const char* const kSnrParams[] = {"range_resolution", "beamwidth_azimuth", "beamwidth_elevation", "monopulse_slope",
                                   "snr_reference", "snr_reference_range", "snr_law", "snr_jitter"};
 
-NoiseModelKind kind_of(const std::string& name) {
-  if (name == "snr") return NoiseModelKind::Snr;
-  if (name == "table4") return NoiseModelKind::Table4;
-  return NoiseModelKind::Constant;
-}
 
-double preset_factor(const std::string& preset) {
-  if (preset == "best") return 0.5;
-  if (preset == "worst") return 2.0;
+
+double preset_factor(NoisePreset preset) {
+  if (preset == NoisePreset::Best) return 0.5;
+  if (preset == NoisePreset::Worst) return 2.0;
   return 1.0;  // none, normal
 }
 
@@ -68,16 +64,16 @@ NoiseSigmas SnrAccuracy::sigmas(double snr_db) const {
 }
 
 NoiseModel::NoiseModel(const Params& p) {
-  const std::string& model = p.text("noise_model");
-  kind_ = kind_of(model);
+  const std::string& model = p.choice_word("noise_model");
+  kind_ = p.choice<NoiseModelKind>("noise_model");
   if (kind_ != NoiseModelKind::Constant) refuse_given(p, kConstantParams, model);
   if (kind_ != NoiseModelKind::Snr) refuse_given(p, kSnrParams, model);
   constant_ = {p.real("sigma_range"), p.real("sigma_azimuth"), p.real("sigma_elevation"), p.real("sigma_range_rate")};
-  link_ = {p.real("snr_reference"), p.real("snr_reference_range"), p.text("snr_law") == "beacon_r2" ? 2 : 4};
+  link_ = {p.real("snr_reference"), p.real("snr_reference_range"), static_cast<int>(p.choice<SnrLaw>("snr_law"))};
   accuracy_ = {p.real("range_resolution"), p.real("beamwidth_azimuth"), p.real("beamwidth_elevation"),
                p.real("monopulse_slope")};
   jitter_db_ = p.real("snr_jitter");
-  scale_ = p.real("noise_factor") * preset_factor(p.text("noise_preset"));
+  scale_ = p.real("noise_factor") * preset_factor(p.choice<NoisePreset>("noise_preset"));
 }
 
 Look NoiseModel::look(double range, Rng& rng) const {

@@ -62,6 +62,9 @@ struct Look {
 };
 
 enum class NoiseModelKind { Constant, Snr, Table4 };
+// The radar's other choice parameters, as enums (ParamSpec::choice<E>).
+enum class SnrLaw { RadarR4 = 4, BeaconR2 = 2 };  // the value is the path-loss exponent
+enum class NoisePreset { None, Best, Normal, Worst };
 
 // Chooses and evaluates the noise model named by the `noise_model` parameter and owns the
 // overall noise scale (noise_factor × noise_preset). Validates that only the parameters of the

@@ -3,6 +3,7 @@
 #include "shot_noise.hpp"
 #include "time_windows.hpp"
 
+#include <trackflow/common_params.hpp>
 #include <trackflow/geometry.hpp>
 #include <trackflow/plugin.hpp>
 #include <trackflow/rng.hpp>
@@ -15,11 +16,8 @@ namespace {
 
 using sim::NoiseSigmas;
 
-MeasMode mode_of(const std::string& name) {
-  if (name == "beacon") return MeasMode::Beacon;
-  if (name == "skin") return MeasMode::Skin;
-  return MeasMode::Unknown;
-}
+enum class ReportedNoise { Actual, Nominal };
+
 
 // A shot_* parameter written while shot noise is off would be silently ignored.
 void check_shot_params(const Params& p, const sim::ShotNoise& shot) {
@@ -49,8 +47,8 @@ class RadarSource final : public Component {
         noise_(p),
         modes_(p, "mode_schedule", true),
         unlocked_(p, "invalid_schedule", false),
-        default_mode_(mode_of(p.text("default_mode"))) {
-    report_nominal_ = p.text("reported_noise") == "nominal";
+        default_mode_(p.choice<MeasMode>("default_mode")) {
+    report_nominal_ = p.choice<ReportedNoise>("reported_noise") == ReportedNoise::Nominal;
     if (report_nominal_ && noise_.scale() == 0.0) throw p.error("noise_factor", "must not be 0 with reported_noise: nominal");
     shot_.enabled = p.boolean("shot_noise");
     shot_.length = p.integer("shot_length");
@@ -58,8 +56,7 @@ class RadarSource final : public Component {
     shot_.offset = p.has("shot_offset") ? p.integer("shot_offset") : shot_.period;
     shot_.magnitude = p.real("shot_magnitude");
     check_shot_params(p, shot_);
-    convention_ = p.text("azimuth_convention") == "north_clockwise" ? AzimuthConvention::NorthClockwise
-                                                                     : AzimuthConvention::XCounterClockwise;
+    convention_ = p.choice<AzimuthConvention>("azimuth_convention");
     const bool with_range_rate = p.boolean("range_rate");
     const int n = with_range_rate ? 4 : 3;
     m_.sensor = static_cast<std::uint32_t>(p.integer("sensor_id"));
@@ -162,7 +159,9 @@ std::vector<ParamSpec> window_fields(bool with_mode) {
       ParamSpec::real("end", dim::time, "end of the window (exclusive), after start").req(),
   };
   if (!with_mode) return f;
-  f.push_back(ParamSpec::choice("mode", {"beacon", "skin"}, "tracking mode written into measurements in this window").req());
+  f.push_back(ParamSpec::choice<MeasMode>("mode", {{MeasMode::Beacon, "beacon"}, {MeasMode::Skin, "skin"}},
+                                          "tracking mode written into measurements in this window")
+                  .req());
   f.push_back(ParamSpec::real("sigma_range", dim::length, "range sigma in this window (default: the noise model's)").at_least(0));
   f.push_back(ParamSpec::real("sigma_azimuth", dim::angle, "azimuth sigma in this window (default: the noise model's)").at_least(0));
   f.push_back(ParamSpec::real("sigma_elevation", dim::angle, "elevation sigma in this window (default: the noise model's)").at_least(0));
@@ -214,7 +213,10 @@ void register_components(Registrar& r) {
   d.params = {
       ParamSpec::real_list("position", dim::length, "radar position in the ENU frame [x east, y north, z up]", 3)
           .def("[0, 0, 0]"),
-      ParamSpec::choice("noise_model", {"constant", "snr", "table4"},
+      ParamSpec::choice<sim::NoiseModelKind>("noise_model",
+                                             {{sim::NoiseModelKind::Constant, "constant"},
+                                              {sim::NoiseModelKind::Snr, "snr"},
+                                              {sim::NoiseModelKind::Table4, "table4"}},
                         "where sigma comes from: the sigma_* values, the SNR link budget (paper 001 eq 6-8), or "
                         "paper 000 Table 4 over range")
           .def("constant"),
@@ -236,7 +238,7 @@ void register_components(Registrar& r) {
           .at_least(-200)
           .at_most(300),
       ParamSpec::real("snr_reference_range", dim::length, "snr model: range of snr_reference").def("10 km").positive(),
-      ParamSpec::choice("snr_law", {"radar_r4", "beacon_r2"},
+      ParamSpec::choice<sim::SnrLaw>("snr_law", {{sim::SnrLaw::RadarR4, "radar_r4"}, {sim::SnrLaw::BeaconR2, "beacon_r2"}},
                         "snr model: SNR falls as R^-4 (skin echo) or R^-2 (beacon/transponder, one-way legs)")
           .def("radar_r4"),
       ParamSpec::real("snr_jitter", dim::decibel, "snr model: standard deviation of the per-measurement SNR error (paper 001: 3 dB)")
@@ -247,10 +249,14 @@ void register_components(Registrar& r) {
           .def("1")
           .at_least(0)
           .at_most(1e6),
-      ParamSpec::choice("noise_preset", {"none", "best", "normal", "worst"},
+      ParamSpec::choice<sim::NoisePreset>("noise_preset",
+                                          {{sim::NoisePreset::None, "none"},
+                                           {sim::NoisePreset::Best, "best"},
+                                           {sim::NoisePreset::Normal, "normal"},
+                                           {sim::NoisePreset::Worst, "worst"}},
                         "paper 000 noise scale: best 0.5x, normal 1x, worst 2x sigma, times noise_factor")
           .def("none"),
-      ParamSpec::choice("reported_noise", {"actual", "nominal"},
+      ParamSpec::choice<ReportedNoise>("reported_noise", {{ReportedNoise::Actual, "actual"}, {ReportedNoise::Nominal, "nominal"}},
                         "covariance reported with each measurement: the sigma actually used, or the sigma before "
                         "noise_factor x noise_preset (a degraded radar that does not know it)")
           .def("actual"),
@@ -266,16 +272,16 @@ void register_components(Registrar& r) {
       ParamSpec::integer("shot_offset", "shot noise: sample index of the first burst (default: shot_period)").at_least(0),
       ParamSpec::records("mode_schedule", window_fields(true),
                          "windows {start, end, mode: beacon|skin, optional sigma_range/azimuth/elevation/range_rate}"),
-      ParamSpec::choice("default_mode", {"unknown", "beacon", "skin"}, "mode of measurements outside mode_schedule windows")
+      ParamSpec::choice<MeasMode>("default_mode",
+                                  {{MeasMode::Unknown, "unknown"}, {MeasMode::Beacon, "beacon"}, {MeasMode::Skin, "skin"}},
+                                  "mode of measurements outside mode_schedule windows")
           .def("unknown"),
       ParamSpec::records("invalid_schedule", window_fields(false),
                          "windows {start, end} in which measurements are flagged valid = false (radar not locked)"),
       ParamSpec::real("bias_range", dim::length, "constant range bias added to every measurement").def("0 m"),
       ParamSpec::real("bias_azimuth", dim::angle, "constant azimuth bias").def("0 rad"),
       ParamSpec::real("bias_elevation", dim::angle, "constant elevation bias").def("0 rad"),
-      ParamSpec::choice("azimuth_convention", {"north_clockwise", "x_counterclockwise"},
-                        "azimuth reference: compass bearing, or math angle from east toward north")
-          .def("north_clockwise"),
+      azimuth_convention_param("azimuth reference: compass bearing, or math angle from east toward north"),
       ParamSpec::integer("sensor_id", "sensor number written into each measurement").def("0").at_least(0).at_most(4294967295.0),
       ParamSpec::integer("every", "measure every N-th truth item received (1: all)").def("1").at_least(1),
   };
@@ -283,6 +289,7 @@ void register_components(Registrar& r) {
   d.min_inputs = 1;
   d.max_inputs = 1;
   d.produces = mask(ItemKind::Measurement);
+  d.produces_frames = mask(Frame::Spherical);
   d.create = [](const Params& p) { return std::make_unique<RadarSource>(p); };
   r.add(std::move(d));
 }

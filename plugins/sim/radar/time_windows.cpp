@@ -33,7 +33,7 @@ TimeWindows::TimeWindows(const Params& p, const std::string& name, bool with_mod
       throw rec.error("end", name + " entry " + std::to_string(i + 1) + ": end (" + seconds(w.end) +
                                  ") must be after start (" + seconds(w.start) + ")");
     if (with_mode) {
-      w.mode = rec.text("mode") == "beacon" ? MeasMode::Beacon : MeasMode::Skin;
+      w.mode = rec.choice<MeasMode>("mode");
       w.sigma_range = optional_real(rec, "sigma_range");
       w.sigma_azimuth = optional_real(rec, "sigma_azimuth");
       w.sigma_elevation = optional_real(rec, "sigma_elevation");

@@ -17,17 +17,17 @@ double sinc(double x) { return std::abs(x) < 1e-4 ? 1.0 - x * x / 6.0 : std::sin
 constexpr double kStillSpeed = 1e-9;  // m/s
 
 struct SegmentRule {
-  const char* type;
+  SegmentType type;
   std::vector<std::string> allowed;   // besides `type`
   std::vector<std::string> required;
 };
 
 const std::vector<SegmentRule>& segment_rules() {
   static const std::vector<SegmentRule> rules = {
-      {"constant_velocity", {"duration"}, {"duration"}},
-      {"constant_acceleration", {"duration", "acceleration"}, {"duration", "acceleration"}},
-      {"turn", {"duration", "turn_rate"}, {"duration", "turn_rate"}},
-      {"velocity_change", {"velocity", "speed", "heading", "climb"}, {}},
+      {SegmentType::ConstantVelocity, {"duration"}, {"duration"}},
+      {SegmentType::ConstantAcceleration, {"duration", "acceleration"}, {"duration", "acceleration"}},
+      {SegmentType::Turn, {"duration", "turn_rate"}, {"duration", "turn_rate"}},
+      {SegmentType::VelocityChange, {"velocity", "speed", "heading", "climb"}, {}},
   };
   return rules;
 }
@@ -39,19 +39,18 @@ std::string quoted_list(const std::vector<std::string>& names) {
 }
 
 void check_fields(const Params& rec, const std::string& label) {
-  const std::string& type = rec.text("type");
+  const SegmentType type = rec.choice<SegmentType>("type");
   const auto& rules = segment_rules();
   const auto rule = std::find_if(rules.begin(), rules.end(), [&](const SegmentRule& r) { return type == r.type; });
-  if (rule == rules.end()) throw rec.error("type", label + ": unknown segment type '" + type + "'");
   for (const auto& [field, value] : rec.values()) {
     if (field == "type" || value.from_default) continue;
     if (std::find(rule->allowed.begin(), rule->allowed.end(), field) == rule->allowed.end())
-      throw rec.error(field, label + ": '" + field + "' does not belong to a " + type + " segment (its fields: " +
-                                 quoted_list(rule->allowed) + ")");
+      throw rec.error(field, label + ": '" + field + "' does not belong to a " + rec.choice_word("type") +
+                                 " segment (its fields: " + quoted_list(rule->allowed) + ")");
   }
   for (const auto& field : rule->required)
-    if (!rec.given(field)) throw rec.error(field, label + ": a " + type + " segment needs '" + field + "'");
-  if (type == "velocity_change") {
+    if (!rec.given(field)) throw rec.error(field, label + ": a " + rec.choice_word("type") + " segment needs '" + field + "'");
+  if (type == SegmentType::VelocityChange) {
     const bool by_vector = rec.given("velocity");
     const bool by_parts = rec.given("speed") || rec.given("heading") || rec.given("climb");
     if (by_vector && by_parts) {
@@ -139,10 +138,10 @@ std::vector<MotionPiece> build_flight_plan(const Params& params) {
   bool change_pending = false;
   for (size_t i = 0; i < segments.size(); ++i) {
     const Params& rec = segments[i];
-    const std::string label = "segment " + std::to_string(i + 1) + " (" + rec.text("type") + ")";
+    const std::string label = "segment " + std::to_string(i + 1) + " (" + rec.choice_word("type") + ")";
     check_fields(rec, label);
-    const std::string& type = rec.text("type");
-    if (type == "velocity_change") {
+    const SegmentType type = rec.choice<SegmentType>("type");
+    if (type == SegmentType::VelocityChange) {
       v = changed_velocity(rec, v, label);
       change_pending = true;
       continue;
@@ -152,10 +151,10 @@ std::vector<MotionPiece> build_flight_plan(const Params& params) {
     piece.end = t + rec.real("duration");
     piece.position = p;
     piece.velocity = v;
-    if (type == "constant_acceleration") {
+    if (type == SegmentType::ConstantAcceleration) {
       piece.motion = Motion::ConstantAcceleration;
       piece.acceleration = rec.vec3("acceleration");
-    } else if (type == "turn") {
+    } else if (type == SegmentType::Turn) {
       piece.motion = Motion::Turn;
       piece.turn_rate = rec.real("turn_rate");
     }

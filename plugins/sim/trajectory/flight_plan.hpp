@@ -9,6 +9,11 @@
 
 namespace trackflow::sim {
 
+// The words of sim.trajectory's choice parameters, as enums (ParamSpec::choice<E>).
+enum class SegmentType { ConstantVelocity, ConstantAcceleration, Turn, VelocityChange };
+enum class Profile { None, Kslv1 };
+enum class Earth { Flat, Spherical };
+
 class LaunchPath;
 
 enum class Motion { ConstantVelocity, ConstantAcceleration, Turn, Launch };

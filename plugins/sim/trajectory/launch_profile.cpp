@@ -73,7 +73,7 @@ void refuse_launch_params(const Params& params) {
 }
 
 std::vector<MotionPiece> build_launch_plan(const Params& params) {
-  const std::string& profile = params.text("profile");
+  const std::string& profile = params.choice_word("profile");
   for (const char* name : {"segments", "initial_position", "initial_velocity"})
     if (params.given(name))
       throw params.error(name, "is not used with 'profile: " + profile + "' (the profile gives the whole flight); remove it");
@@ -83,7 +83,7 @@ std::vector<MotionPiece> build_launch_plan(const Params& params) {
   LaunchSite site;
   site.pad = params.vec3("pad_position");
   site.azimuth = params.real("launch_azimuth");
-  site.spherical = params.text("earth") == "spherical";
+  site.spherical = params.choice<Earth>("earth") == Earth::Spherical;
   MotionPiece piece;
   piece.motion = Motion::Launch;
   try {

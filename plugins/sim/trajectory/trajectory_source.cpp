@@ -21,7 +21,7 @@ constexpr double kTimeTolerance = 1e-9;  // s
 class TrajectorySource final : public Generator {
  public:
   explicit TrajectorySource(const Params& params)
-      : pieces_(params.text("profile") == "none" ? sim::build_flight_plan(params) : sim::build_launch_plan(params)),
+      : pieces_(params.choice<sim::Profile>("profile") == sim::Profile::None ? sim::build_flight_plan(params) : sim::build_launch_plan(params)),
         rate_(params.real("rate")),
         start_(params.real("start_time")),
         noise_(sim::process_noise_q(params), 1.0 / rate_) {
@@ -76,7 +76,11 @@ class TrajectorySource final : public Generator {
 
 std::vector<ParamSpec> segment_fields() {
   return {
-      ParamSpec::choice("type", {"constant_velocity", "constant_acceleration", "turn", "velocity_change"},
+      ParamSpec::choice<sim::SegmentType>("type",
+                                     {{sim::SegmentType::ConstantVelocity, "constant_velocity"},
+                                      {sim::SegmentType::ConstantAcceleration, "constant_acceleration"},
+                                      {sim::SegmentType::Turn, "turn"},
+                                      {sim::SegmentType::VelocityChange, "velocity_change"}},
                         "kind of motion over this segment")
           .req(),
       ParamSpec::real("duration", dim::time, "length of the segment (all types except velocity_change, which is instantaneous)")
@@ -142,10 +146,14 @@ void register_components(Registrar& r) {
       ParamSpec::real_list("initial_velocity", dim::velocity, "ENU velocity at start_time (segments only)", 3).def("[0, 0, 0]"),
       ParamSpec::integer("target", "target id written into each Truth item").def("0").at_least(0).at_most(4294967295.0),
       ParamSpec::records("segments", segment_fields(), "the flight, in order (at least one; required without a profile)"),
-      ParamSpec::choice("profile", {"none", "kslv1"}, "fly a tabulated launch profile instead of segments").def("none"),
+      ParamSpec::choice<sim::Profile>("profile", {{sim::Profile::None, "none"}, {sim::Profile::Kslv1, "kslv1"}},
+                                 "fly a tabulated launch profile instead of segments")
+          .def("none"),
       ParamSpec::real_list("pad_position", dim::length, "profile: launch pad position in the ENU frame", 3),
       ParamSpec::real("launch_azimuth", dim::angle, "profile: compass direction of the downrange track, from north clockwise"),
-      ParamSpec::choice("earth", {"flat", "spherical"}, "profile: flat ground line (paper 000) or a spherical earth").def("flat"),
+      ParamSpec::choice<sim::Earth>("earth", {{sim::Earth::Flat, "flat"}, {sim::Earth::Spherical, "spherical"}},
+                               "profile: flat ground line (paper 000) or a spherical earth")
+          .def("flat"),
       ParamSpec::real("profile_duration", dim::time, "profile: fly only the first part of it (default: the whole table)").positive(),
       ParamSpec::real("process_noise_q", dim::accel_psd,
                       "spectral density of white acceleration added to the truth, every ENU axis (0: off)")

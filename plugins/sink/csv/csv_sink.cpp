@@ -19,7 +19,7 @@ namespace {
 
 constexpr const char* kHeader =
     "run,time,source,kind,updated,x,y,z,vx,vy,vz,sigma_x,sigma_y,sigma_z,sigma_vx,sigma_vy,sigma_vz,nis,nees,"
-    "truth_x,truth_y,truth_z,truth_vx,truth_vy,truth_vz,quality_range,quality_azimuth,quality_elevation\n";
+    "truth_x,truth_y,truth_z,truth_vx,truth_vy,truth_vz";
 
 // Truth samples within this of an item's time are its truth (the same default as sink.metrics).
 constexpr double kTimeTolerance = 1e-6;
@@ -42,7 +42,8 @@ struct PendingRow {
   Vec6 value = Vec6::Zero();
   Vec6 sigma = Vec6::Zero();
   Mat6 covariance = Mat6::Zero();  // estimates: for NEES
-  int quality[3] = {-1, -1, -1};   // estimates: Estimate::quality, -1 = no grade
+  double annotations[kMaxAnnotations] = {};  // estimates: their filter's adapter annotations
+  int annotation_count = 0;
 };
 
 class CsvSink final : public Component {
@@ -60,11 +61,22 @@ class CsvSink final : public Component {
 
   void set_inputs(const std::vector<InputInfo>& inputs) override {
     sources_.clear();
+    annotation_columns_.clear();
+    column_of_.clear();
     truth_input_ = false;
     for (const auto& in : inputs) {
       sources_.push_back(csv::quoted(in.node));
       truth_input_ |= (in.kinds & mask(ItemKind::Truth)) != 0;
+      // One column per annotation that exists in the pipeline ("<adapter id>.<name>"), shared
+      // by inputs that carry the same name.
+      auto& columns = column_of_.emplace_back();
+      for (const auto& name : in.annotations) {
+        auto it = std::find(annotation_columns_.begin(), annotation_columns_.end(), name);
+        if (it == annotation_columns_.end()) it = annotation_columns_.insert(annotation_columns_.end(), name);
+        columns.push_back(static_cast<int>(it - annotation_columns_.begin()));
+      }
     }
+    row_annotations_.assign(annotation_columns_.size(), 0.0);
   }
 
   void start_run(const RunContext& ctx) override {
@@ -100,7 +112,8 @@ class CsvSink final : public Component {
     r.has_sigma = true;
     for (int i = 0; i < 6; ++i) r.sigma(i) = e.enu_covariance(i, i) >= 0.0 ? std::sqrt(e.enu_covariance(i, i)) : NAN;
     r.covariance = e.enu_covariance;
-    for (int c = 0; c < 3; ++c) r.quality[c] = e.quality[c];
+    r.annotation_count = e.annotation_count;
+    for (int i = 0; i < e.annotation_count; ++i) r.annotations[i] = e.annotations[i];
     flush(false);
   }
 
@@ -145,6 +158,8 @@ class CsvSink final : public Component {
     std::ofstream os(file, std::ios::binary | std::ios::trunc);
     if (os) {
       os << kHeader;
+      for (const auto& name : annotation_columns_) os << ',' << csv::quoted(name);
+      os << '\n';
       os.write(file_.data(), static_cast<std::streamsize>(file_.size()));
       os.flush();
     }
@@ -216,12 +231,13 @@ class CsvSink final : public Component {
     }
     w.real(nees);
     for (int i = 0; i < 6; ++i) w.real_if(t != nullptr, truth(i));
-    for (int c = 0; c < 3; ++c) {
-      if (r.quality[c] >= 0)
-        w.integer(static_cast<std::uint64_t>(r.quality[c]));
-      else
-        w.empty();
+    std::fill(row_annotations_.begin(), row_annotations_.end(), std::numeric_limits<double>::quiet_NaN());
+    if (!r.measurement && r.port >= 0 && static_cast<size_t>(r.port) < column_of_.size()) {
+      const auto& columns = column_of_[static_cast<size_t>(r.port)];
+      for (int i = 0; i < r.annotation_count && static_cast<size_t>(i) < columns.size(); ++i)
+        row_annotations_[static_cast<size_t>(columns[static_cast<size_t>(i)])] = r.annotations[i];
     }
+    for (double a : row_annotations_) w.real_if(!std::isnan(a), a);
     w.end();
     ++row_count_;
   }
@@ -231,6 +247,9 @@ class CsvSink final : public Component {
   const bool include_measurements_;
   const int precision_;
   std::vector<std::string> sources_;
+  std::vector<std::string> annotation_columns_;
+  std::vector<std::vector<int>> column_of_;  // per input port: annotation index -> column
+  std::vector<double> row_annotations_;      // scratch of one row, sized once
   bool truth_input_ = true;  // until set_inputs says otherwise, rows wait for truth
   // Per run.
   std::uint64_t run_ = 0;
@@ -251,12 +270,13 @@ void register_components(Registrar& r) {
   d.kind = ComponentKind::Sink;
   d.summary = "Writes estimates (any number of filters), optional measurements and matching truth of all runs to one CSV file";
   d.doc =
-      "Columns: run,time,source,kind,updated,x,y,z,vx,vy,vz,sigma_x..sigma_vz,nis,nees,truth_x..truth_vz,"
-      "quality_range,quality_azimuth,quality_elevation. source is "
-      "the upstream node id; kind is estimate or measurement. Truth columns and nees are filled when a truth sample "
-      "lies within 1 us of the row's time, nis when the estimate was updated; quality_* hold the per-channel grade "
-      "an adapter stamped on the estimate (Estimate::quality; adapt.quality_switch: 0 best, 1 normal, 2 worst), "
-      "empty when there is none; missing values are empty cells. "
+      "Columns: run,time,source,kind,updated,x,y,z,vx,vy,vz,sigma_x..sigma_vz,nis,nees,truth_x..truth_vz, then one "
+      "column per annotation the pipeline's adapters publish on the estimates of this sink's inputs, named "
+      "<adapter id>.<name> (e.g. qs.grade_range: adapt.quality_switch's grade, 0 best, 1 normal, 2 worst; "
+      "adaptive_r.sigma_x: adapt.innovation_r's adapted sigma, m), empty when the adapter has published none yet. "
+      "source is the upstream node id; kind is estimate or measurement. Truth columns and nees are filled when a "
+      "truth sample lies within 1 us of the row's time, nis when the estimate was updated; missing values are "
+      "empty cells. "
       "Measurement rows carry the Cartesian position (spherical ones converted) and, when Cartesian, the sigmas "
       "of the covariance diagonal. Only initialised estimates and valid measurements are written. Rows are in "
       "run order, then arrival order, so the file is identical for a given seed whatever the thread count.";

@@ -18,14 +18,15 @@ namespace fs = std::filesystem;
 
 namespace {
 
-const InputInfo kKf{"kf", "filter.kalman", mask(ItemKind::Estimate)};
+// kf carries the annotations of an adapter 'qs' (e.g. adapt.quality_switch); ekf none.
+const InputInfo kKf{"kf", "filter.kalman", mask(ItemKind::Estimate), {"qs.grade_range", "qs.grade_azimuth", "qs.grade_elevation"}};
 const InputInfo kEkf{"ekf", "filter.ekf", mask(ItemKind::Estimate)};
 const InputInfo kTruth{"truth", "sim.trajectory", mask(ItemKind::Truth)};
 const InputInfo kCm{"cm", "convert.classical", mask(ItemKind::Measurement)};
 
 const std::string kHeader =
     "run,time,source,kind,updated,x,y,z,vx,vy,vz,sigma_x,sigma_y,sigma_z,sigma_vx,sigma_vy,sigma_vz,nis,nees,"
-    "truth_x,truth_y,truth_z,truth_vx,truth_vy,truth_vz,quality_range,quality_azimuth,quality_elevation";
+    "truth_x,truth_y,truth_z,truth_vx,truth_vy,truth_vz,qs.grade_range,qs.grade_azimuth,qs.grade_elevation";
 enum Col { Run, Time, Source, Kind, Updated, X, Y, Z, VX, VY, VZ, SX, SY, SZ, SVX, SVY, SVZ, Nis, Nees, TX, TY, TZ, TVX, TVY, TVZ,
            QR, QAZ, QEL, Cells };
 
@@ -227,18 +228,19 @@ TEST_CASE("cells without a value are empty: no truth at that time, non-positive 
   CHECK(s.find("rows")->value == 2);
 }
 
-TEST_CASE("quality columns carry the grades an adapter stamped on the estimate, empty where there is none") {
+TEST_CASE("annotation columns carry what an adapter published on the estimate and are empty where there is none") {
   const fs::path dir = scratch("quality");
   auto c = make_csv("{}");
   Diagnostics diag;
   c->start_run({0, 1, &diag});
   c->on_truth(truth(0.0, Vec3(1, 2, 3), Vec3::Zero()), 2);
   Estimate graded = estimate(0.0, Vec6::Zero(), Mat6::Identity());
-  graded.quality[0] = 0;
-  graded.quality[1] = 2;
-  graded.quality[2] = -1;  // not graded yet
+  graded.annotation_count = 3;
+  graded.annotations[0] = 0;
+  graded.annotations[1] = 2;
+  graded.annotations[2] = std::numeric_limits<double>::quiet_NaN();  // not graded yet
   c->on_estimate(graded, 0);
-  c->on_estimate(estimate(0.0, Vec6::Zero(), Mat6::Identity()), 1);  // no adapter: -1 everywhere
+  c->on_estimate(estimate(0.0, Vec6::Zero(), Mat6::Identity()), 1);  // no adapter: empty everywhere
   auto result = c->end_run();
   c->merge(*result);
   Summary s;

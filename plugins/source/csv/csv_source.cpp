@@ -2,6 +2,7 @@
 #include "csv_text.hpp"
 
 #include <trackflow/geometry.hpp>
+#include <trackflow/common_params.hpp>
 #include <trackflow/plugin.hpp>
 
 #include <cerrno>
@@ -32,10 +33,22 @@ std::string format_number(double v) {
   return buf;
 }
 
-double angle_scale(const std::string& unit) {
-  if (unit == "deg") return std::numbers::pi / 180.0;
-  if (unit == "mrad") return 1e-3;
+enum class LogFrame { Spherical, Cartesian };
+enum class TimeUnit { Second, Millisecond };
+enum class LengthUnit { Metre, Kilometre };
+enum class AngleUnit { Degree, Radian, Milliradian };
+enum class OnBadRow { Error, Skip };
+
+double angle_scale(AngleUnit unit) {
+  if (unit == AngleUnit::Degree) return std::numbers::pi / 180.0;
+  if (unit == AngleUnit::Milliradian) return 1e-3;
   return 1.0;
+}
+
+double length_scale(LengthUnit unit) { return unit == LengthUnit::Kilometre ? 1e3 : 1.0; }
+
+ParamSpec length_unit_param(const char* name, const char* doc) {
+  return ParamSpec::choice<LengthUnit>(name, {{LengthUnit::Metre, "m"}, {LengthUnit::Kilometre, "km"}}, doc).def("m");
 }
 
 // Relative paths are relative to the pipeline file that wrote them, so a pipeline and its data
@@ -65,7 +78,7 @@ std::string read_file(const Params& p, const fs::path& path) {
 
 class CsvSource final : public Generator {
  public:
-  explicit CsvSource(const Params& p) : node_(p.node()), skip_bad_rows_(p.text("on_bad_row") == "skip") {
+  explicit CsvSource(const Params& p) : node_(p.node()), skip_bad_rows_(p.choice<OnBadRow>("on_bad_row") == OnBadRow::Skip) {
     configure(p);
     const fs::path path = resolve_path(p);
     file_ = path.string();
@@ -79,6 +92,8 @@ class CsvSource final : public Generator {
     if (ctx.run == 0 && ctx.diagnostics)
       for (const auto& message : skipped_) ctx.diagnostics->skip(node_, message);
   }
+
+  FrameMask produced_frames() const override { return mask(frame_); }
 
   double next_time() const override {
     return cursor_ < items_.size() ? items_[cursor_].time : std::numeric_limits<double>::infinity();
@@ -95,7 +110,8 @@ class CsvSource final : public Generator {
 
  private:
   void configure(const Params& p) {
-    const bool cartesian = p.text("frame") == "cartesian";
+    const bool cartesian = p.choice<LogFrame>("frame") == LogFrame::Cartesian;
+    frame_ = cartesian ? Frame::Cartesian : Frame::Spherical;
     // A parameter of the other frame would be silently ignored; say so instead.
     const std::vector<const char*> spherical_only = {"range_column", "azimuth_column", "elevation_column",
                                                      "range_unit",   "angle_unit",     "sigma_range",
@@ -105,11 +121,11 @@ class CsvSource final : public Generator {
     for (const char* name : cartesian ? spherical_only : cartesian_only)
       if (p.given(name))
         throw p.error(name, std::string("applies only to frame: ") + (cartesian ? "spherical" : "cartesian") +
-                                ", and this source reads frame: " + p.text("frame"));
+                                ", and this source reads frame: " + p.choice_word("frame"));
     if (p.given("sigma_range_rate") && !p.has("range_rate_column"))
       throw p.error("sigma_range_rate", "applies only when range_rate_column names the range-rate column");
 
-    time_scale_ = p.text("time_unit") == "ms" ? 1e-3 : 1.0;
+    time_scale_ = p.choice<TimeUnit>("time_unit") == TimeUnit::Millisecond ? 1e-3 : 1.0;
     auto column = [&](const char* param) {
       Column c;
       c.param = param;
@@ -121,15 +137,15 @@ class CsvSource final : public Generator {
       value_[0] = column("x_column");
       value_[1] = column("y_column");
       value_[2] = column("z_column");
-      const double length = p.text("position_unit") == "km" ? 1e3 : 1.0;
+      const double length = length_scale(p.choice<LengthUnit>("position_unit"));
       scale_[0] = scale_[1] = scale_[2] = length;
       rdot_scale_ = length;
     } else {
       value_[0] = column("range_column");
       value_[1] = column("azimuth_column");
       value_[2] = column("elevation_column");
-      const double length = p.text("range_unit") == "km" ? 1e3 : 1.0;
-      const double angle = angle_scale(p.text("angle_unit"));
+      const double length = length_scale(p.choice<LengthUnit>("range_unit"));
+      const double angle = angle_scale(p.choice<AngleUnit>("angle_unit"));
       scale_[0] = length;
       scale_[1] = scale_[2] = angle;
       rdot_scale_ = length;
@@ -142,8 +158,7 @@ class CsvSource final : public Generator {
 
     Measurement& m = prototype_;
     m.frame = cartesian ? Frame::Cartesian : Frame::Spherical;
-    m.azimuth = p.text("azimuth_convention") == "x_counterclockwise" ? AzimuthConvention::XCounterClockwise
-                                                                       : AzimuthConvention::NorthClockwise;
+    m.azimuth = p.choice<AzimuthConvention>("azimuth_convention");
     m.sensor = static_cast<std::uint32_t>(p.integer("sensor_id"));
     m.sensor_position = p.vec3("position");
     m.has_range_rate = !range_rate_.name.empty();
@@ -331,13 +346,15 @@ class CsvSource final : public Generator {
   std::vector<std::string> skipped_;
   std::size_t rows_ = 0;
   std::size_t cursor_ = 0;
+  Frame frame_ = Frame::Spherical;
 };
 
 std::vector<ParamSpec> csv_params() {
   using P = ParamSpec;
   return {
       P::string("path", "CSV file; a relative path is relative to the pipeline file's folder").req(),
-      P::choice("frame", {"spherical", "cartesian"}, "what the rows hold: range/azimuth/elevation or x/y/z ENU")
+      P::choice<LogFrame>("frame", {{LogFrame::Spherical, "spherical"}, {LogFrame::Cartesian, "cartesian"}},
+                          "what the rows hold: range/azimuth/elevation or x/y/z ENU")
           .def("spherical"),
       P::string("time_column", "column with the measurement time").def("time"),
       P::string("range_column", "spherical: column with the range").def("range"),
@@ -351,10 +368,14 @@ std::vector<ParamSpec> csv_params() {
       P::string("mode_column", "column with the track mode: beacon or skin (any case), anything else is unknown"),
       P::string("valid_column", "column with the validity flag: 1/0/true/false; invalid rows make filters coast"),
       P::string("sensor_column", "column with the sensor id (non-negative integer); overrides sensor_id"),
-      P::choice("time_unit", {"s", "ms"}, "unit of the time column").def("s"),
-      P::choice("range_unit", {"m", "km"}, "spherical: unit of range (and range rate per second)").def("m"),
-      P::choice("angle_unit", {"deg", "rad", "mrad"}, "spherical: unit of azimuth and elevation").def("deg"),
-      P::choice("position_unit", {"m", "km"}, "cartesian: unit of x, y, z (and range rate per second)").def("m"),
+      P::choice<TimeUnit>("time_unit", {{TimeUnit::Second, "s"}, {TimeUnit::Millisecond, "ms"}}, "unit of the time column")
+          .def("s"),
+      length_unit_param("range_unit", "spherical: unit of range (and range rate per second)"),
+      P::choice<AngleUnit>("angle_unit",
+                           {{AngleUnit::Degree, "deg"}, {AngleUnit::Radian, "rad"}, {AngleUnit::Milliradian, "mrad"}},
+                           "spherical: unit of azimuth and elevation")
+          .def("deg"),
+      length_unit_param("position_unit", "cartesian: unit of x, y, z (and range rate per second)"),
       P::real("sigma_range", dim::length, "spherical: range noise standard deviation").def("10 m").positive(),
       P::real("sigma_azimuth", dim::angle, "spherical: azimuth noise standard deviation").def("1 mrad").positive(),
       P::real("sigma_elevation", dim::angle, "spherical: elevation noise standard deviation").def("1 mrad").positive(),
@@ -363,14 +384,12 @@ std::vector<ParamSpec> csv_params() {
           .def("10 m")
           .positive(),
       P::real_list("position", dim::length, "sensor position in the ENU frame [x, y, z]", 3).def("[0, 0, 0]"),
-      P::choice("azimuth_convention", {"north_clockwise", "x_counterclockwise"},
-                "how the file's azimuth is measured: compass bearing, or from east toward north")
-          .def("north_clockwise"),
+      azimuth_convention_param("how the file's azimuth is measured: compass bearing, or from east toward north"),
       P::integer("sensor_id", "sensor id of every row (unless sensor_column is given)")
           .def("0")
           .at_least(0)
           .at_most(std::numeric_limits<std::uint32_t>::max()),
-      P::choice("on_bad_row", {"error", "skip"},
+      P::choice<OnBadRow>("on_bad_row", {{OnBadRow::Error, "error"}, {OnBadRow::Skip, "skip"}},
                 "a malformed row stops the pipeline (error) or is left out and reported (skip)")
           .def("error"),
   };

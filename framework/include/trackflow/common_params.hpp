@@ -1,0 +1,30 @@
+// Purpose: parameter declarations several plugins share (azimuth convention, range-rate use), each with its enum.
+#pragma once
+
+#include <trackflow/items.hpp>
+#include <trackflow/params.hpp>
+
+#include <cstdint>
+#include <string>
+
+namespace trackflow {
+
+// Whether a spherical filter uses the measurement's range rate (the 4th value).
+enum class RangeRateUse : std::uint8_t { Auto, Use, Ignore };
+
+inline ParamSpec range_rate_param() {
+  return ParamSpec::choice<RangeRateUse>(
+             "range_rate", {{RangeRateUse::Auto, "auto"}, {RangeRateUse::Use, "use"}, {RangeRateUse::Ignore, "ignore"}},
+             "use the 4th element (range rate): when present (auto), always (use), never (ignore)")
+      .def("auto");
+}
+
+inline ParamSpec azimuth_convention_param(std::string doc) {
+  return ParamSpec::choice<AzimuthConvention>("azimuth_convention",
+                                              {{AzimuthConvention::NorthClockwise, "north_clockwise"},
+                                               {AzimuthConvention::XCounterClockwise, "x_counterclockwise"}},
+                                              std::move(doc))
+      .def("north_clockwise");
+}
+
+}  // namespace trackflow

@@ -1,0 +1,234 @@
+// Purpose: the one measurement front end every filter uses — validity, frame, well-formedness, time order, range rate, R, adapter hooks, non-finite check, initialise/predict/update/publish — with its counted skips.
+#pragma once
+
+#include <trackflow/component.hpp>
+#include <trackflow/error.hpp>
+#include <trackflow/common_params.hpp>
+
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace trackflow {
+
+struct FrontEndSpec {
+  std::string type;  // "filter.kalman", for messages
+  std::string node;
+  Frame frame = Frame::Spherical;  // the measurements the filter works on
+  // Spherical filters: use the range rate when present (Auto), always (Use) or never (Ignore).
+  // Cartesian filters take the three position values: Ignore.
+  RangeRateUse range_rate = RangeRateUse::Ignore;
+  // Filter-specific events counted per run and reported in the summary (see count()).
+  std::vector<std::string> counters;
+};
+
+// Counts of one run, summed in run order into the node's summary.
+struct FrontEndRunResult final : RunResult {
+  static constexpr int kMaxCounters = 4;
+  std::uint64_t updates = 0;     // measurements used
+  std::uint64_t coasted = 0;     // invalid measurements: predicted through
+  std::uint64_t non_finite = 0;  // flagged valid but non-finite (value or R): predicted through
+  std::uint64_t rejected = 0;    // the filter refused the update (it said why in a warning)
+  std::uint64_t counters[kMaxCounters] = {};
+};
+
+// The template method of every filter (CRTP: no virtual call on the hot path). Derived provides
+//   bool reset_track();                          start of a run: forget the track; return true
+//                                                when it starts initialised (explicit state)
+//   bool initialise(const Measurement& m, int dim);   a usable measurement while not yet
+//                                                initialised; true once the state is formed
+//   void predict(double T);                      T > 0 seconds
+//   template <int M> bool update(const Measurement& m);   M = 3 or 4 values; on success call
+//                                                accept_update(); false: not used (warn() why)
+//   void fill_estimate(Estimate& e) const;       state, covariance, enu, enu_covariance
+//   void scale_state_covariance(double k);       P <- k P in the filter's own representation
+// and may hide (defaults below): check_measurement(m) for further checks on valid measurements,
+// on_end_run() for per-run reports.
+template <class Derived>
+class FilterFrontEnd : public Filter {
+ public:
+  void start_run(const RunContext& ctx) final {
+    diag_ = ctx.diagnostics;
+    has_time_ = false;
+    non_finite_reported_ = false;
+    run_ = FrontEndRunResult{};
+    clear_innovation();
+    initialised_ = derived().reset_track();
+  }
+
+  void on_measurement(const Measurement& m, int) final {
+    const int n = static_cast<int>(m.value.size());
+    const bool well_formed =
+        m.frame == spec_.frame && n == (m.has_range_rate ? 4 : 3) && m.covariance.rows() == n && m.covariance.cols() == n;
+    // An invalid measurement (radar not locked) is coasted through whatever it holds: a converter
+    // passes it on unconverted, so neither its frame nor its shape is checked.
+    if (m.valid) check_valid(m, n, well_formed);
+    if (has_time_ && m.time < time_) {
+      if (diag_)
+        diag_->skip(spec_.node, "measurement at t=" + std::to_string(m.time) + " s is older than the previous one (t=" +
+                                    std::to_string(time_) + " s)");
+      return;
+    }
+    const int dim = dimension(m);
+    if (well_formed && n >= dim) R_ = m.covariance.topLeftCorner(dim, dim);
+    before_update(m);  // adapters may replace R_ and the process noise
+    if (m.valid && (R_.rows() < dim || R_.cols() < dim))
+      throw DataError(who() + ": an adapter left a " + std::to_string(R_.rows()) + "x" + std::to_string(R_.cols()) +
+                      " R for a " + std::to_string(dim) + "-element measurement");
+    const bool usable = m.valid && m.value.head(dim).allFinite() && R_.topLeftCorner(dim, dim).allFinite();
+    if (!m.valid) {
+      ++run_.coasted;
+    } else if (!usable) {
+      ++run_.non_finite;
+      if (!non_finite_reported_)
+        warn("non-finite measurement or R at t=" + std::to_string(m.time) +
+             " s treated as invalid (coasted); further ones are counted in the summary");
+      non_finite_reported_ = true;
+    }
+    const bool had_time = has_time_;
+    const double T = m.time - time_;
+    time_ = m.time;
+    has_time_ = true;
+    if (!initialised_) {
+      if (usable && derived().initialise(m, dim)) {
+        initialised_ = true;
+        clear_innovation();
+        publish_state(m);
+      } else {
+        set_uninitialised(est_, m.time);
+        publish(m, est_);
+      }
+      return;
+    }
+    if (had_time && T > 0.0) derived().predict(T);
+    clear_innovation();
+    if (usable) {
+      const bool used = dim == 4 ? derived().template update<4>(m) : derived().template update<3>(m);
+      ++(used ? run_.updates : run_.rejected);
+    }
+    publish_state(m);
+  }
+
+  std::unique_ptr<RunResult> end_run() final {
+    derived().on_end_run();
+    return std::make_unique<FrontEndRunResult>(run_);
+  }
+
+  void merge(RunResult& result) final {
+    const auto& r = static_cast<const FrontEndRunResult&>(result);
+    total_.updates += r.updates;
+    total_.coasted += r.coasted;
+    total_.non_finite += r.non_finite;
+    total_.rejected += r.rejected;
+    for (int i = 0; i < FrontEndRunResult::kMaxCounters; ++i) total_.counters[i] += r.counters[i];
+  }
+
+  void finish(Summary& s, const FinishContext&) override {
+    s.metric("updates", static_cast<double>(total_.updates));
+    s.metric("coasted", static_cast<double>(total_.coasted));
+    if (total_.non_finite) s.metric("non_finite_skipped", static_cast<double>(total_.non_finite));
+    if (total_.rejected) s.metric("updates_refused", static_cast<double>(total_.rejected));
+    for (size_t i = 0; i < spec_.counters.size() && i < FrontEndRunResult::kMaxCounters; ++i)
+      s.metric(spec_.counters[i], static_cast<double>(total_.counters[i]));
+  }
+
+  bool initialised() const { return initialised_; }
+
+  // Covariance access for adapters, the same for every filter: the covariance as last published,
+  // a rescale that the filter applies to whatever representation of P it keeps, a restart.
+  bool has_covariance_access() const final { return true; }
+  void read_covariance(StateCov& P) const final {
+    if (initialised_)
+      P = est_.covariance;
+    else
+      P.resize(0, 0);
+  }
+  void scale_covariance(double factor) final {
+    if (initialised_ && factor > 0.0 && factor < std::numeric_limits<double>::infinity())
+      derived().scale_state_covariance(factor);
+  }
+  void restart_track() final { initialised_ = derived().reset_track(); }
+
+ protected:
+  explicit FilterFrontEnd(FrontEndSpec spec) : spec_(std::move(spec)) { R_ = MeasCov::Zero(3, 3); }
+
+  // Defaults Derived may hide.
+  void check_measurement(const Measurement&) {}
+  void on_end_run() {}
+
+  const FrontEndSpec& spec() const { return spec_; }
+  std::string who() const { return spec_.type + " (node '" + spec_.node + "')"; }
+  void warn(const std::string& message) const {
+    if (diag_) diag_->warn(spec_.node, message);
+  }
+  Diagnostics* diagnostics() const { return diag_; }
+  // Time of the measurement being processed (predict() runs to it).
+  double time() const { return time_; }
+  void count(int counter) { ++run_.counters[counter]; }
+
+  template <int M>
+  void accept_update(const Eigen::Matrix<double, M, 1>& nu, const Eigen::Matrix<double, M, M>& S, double nis) {
+    est_.updated = true;
+    est_.innovation = nu;
+    est_.innovation_covariance = S;
+    est_.nis = nis;
+  }
+
+  MeasCov R_;  // this step's measurement noise, exposed to adapters through noise()
+  Estimate est_;
+
+ private:
+  Derived& derived() { return static_cast<Derived&>(*this); }
+
+  void check_valid(const Measurement& m, int n, bool well_formed) {
+    if (m.frame != spec_.frame)
+      throw DataError(who() + " takes " + to_string(spec_.frame) + " measurements, but the one at t=" +
+                      std::to_string(m.time) + " s is " + to_string(m.frame) +
+                      (spec_.frame == Frame::Cartesian ? "; put a convert.* node between the radar and it" : ""));
+    if (!well_formed)
+      throw DataError(who() + ": measurement at t=" + std::to_string(m.time) + " s has " + std::to_string(n) +
+                      " values and a " + std::to_string(m.covariance.rows()) + "x" +
+                      std::to_string(m.covariance.cols()) + " covariance; expected " +
+                      (m.has_range_rate ? "4 (with range rate)" : "3") + " values and a matching covariance");
+    if (spec_.range_rate == RangeRateUse::Use && !m.has_range_rate)
+      throw DataError(who() + ": range_rate: use, but the measurement at t=" + std::to_string(m.time) +
+                      " s has no range rate (range_rate: auto accepts both)");
+    derived().check_measurement(m);
+  }
+
+  int dimension(const Measurement& m) const {
+    switch (spec_.range_rate) {
+      case RangeRateUse::Use: return 4;
+      case RangeRateUse::Auto: return m.has_range_rate ? 4 : 3;
+      case RangeRateUse::Ignore: break;
+    }
+    return 3;
+  }
+
+  void clear_innovation() {
+    est_.updated = false;
+    est_.innovation.resize(0);
+    est_.innovation_covariance.resize(0, 0);
+    est_.nis = 0.0;
+  }
+
+  void publish_state(const Measurement& m) {
+    est_.time = m.time;
+    est_.initialised = true;
+    derived().fill_estimate(est_);
+    publish(m, est_);
+  }
+
+  FrontEndSpec spec_;
+  Diagnostics* diag_ = nullptr;
+  double time_ = 0.0;
+  bool has_time_ = false, initialised_ = false, non_finite_reported_ = false;
+  FrontEndRunResult run_, total_;
+};
+
+}  // namespace trackflow

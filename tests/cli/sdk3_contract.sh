@@ -1,0 +1,159 @@
+#!/usr/bin/env bash
+# Purpose: the typed filter–adapter contract and frame-typed ports: wrong wires and wrong attachments refused at validate time with file:line:col; invalid log rows coast every convert.* -> filter combination; adapted noise restored by the engine at every run.
+set -u
+TF=$1
+PLUGINS=$2
+TEST_PLUGINS="$PLUGINS/../test-plugins"
+source "$(dirname "$0")/lib.sh"
+
+radar_nodes() {
+  cat <<'YAML'
+pipeline: { name: contract, seed: 3, runs: 4 }
+nodes:
+  - id: truth
+    type: sim.trajectory
+    params:
+      rate: 10 Hz
+      initial_position: [6000, 8000, 1000]
+      initial_velocity: [-150, 50, 0]
+      segments: [ { type: constant_velocity, duration: 20 s } ]
+  - id: radar
+    type: sim.radar
+    input: truth
+YAML
+}
+
+# 1. A spherical radar wired straight into a Cartesian-only filter.
+{ radar_nodes; cat <<'YAML'
+  - id: kf
+    type: filter.kalman
+    input: radar
+YAML
+} > "$TMP/radar_kalman.yaml"
+expect_run "sim.radar -> filter.kalman refused at the input line" 2 \
+  "radar_kalman.yaml:14:12: node 'kf': input 'radar' \(sim.radar\) produces spherical measurements, but filter.kalman takes cartesian measurements; insert a converter between them \(convert.classical" \
+  -- "$TF" validate "$TMP/radar_kalman.yaml"
+
+# 2. Adapters whose noise the filter does not have.
+{ radar_nodes; cat <<'YAML'
+  - id: gt
+    type: filter.gain_transform
+    input: radar
+    params: { singer_sigma: 10 m/s2 }
+  - id: qs
+    type: adapt.quality_switch
+    attach_to: gt
+YAML
+} > "$TMP/qs_gt.yaml"
+expect_run "adapt.quality_switch on filter.gain_transform refused at attach_to" 2 \
+  "qs_gt.yaml:19:16: node 'qs': cannot attach adapter 'qs' \(adapt.quality_switch\) to filter 'gt' \(filter.gain_transform\): the adapter writes process noise as spectral densities in m2/s5.*but the filter's process noise is 3 standard deviations in m/s2, per ENU axis" \
+  -- "$TF" validate "$TMP/qs_gt.yaml"
+
+{ radar_nodes; cat <<'YAML'
+  - id: ekf
+    type: filter.ekf
+    input: radar
+  - id: air
+    type: adapt.innovation_r
+    attach_to: ekf
+YAML
+} > "$TMP/ir_ekf.yaml"
+expect_run "adapt.innovation_r on a spherical-R filter refused at attach_to" 2 \
+  "ir_ekf.yaml:18:16: node 'air': cannot attach adapter 'air' \(adapt.innovation_r\) to filter 'ekf' \(filter.ekf\): the adapter writes R of Cartesian positions.*but the filter's R is R of \[range m, azimuth rad, elevation rad" \
+  -- "$TF" validate "$TMP/ir_ekf.yaml"
+
+# filter.ekf with constant velocity has q in m2/s3: the quality switch (white jerk) is refused too.
+{ radar_nodes; cat <<'YAML'
+  - id: ekf
+    type: filter.ekf
+    input: radar
+  - id: qs
+    type: adapt.quality_switch
+    attach_to: ekf
+YAML
+} > "$TMP/qs_cv.yaml"
+expect_run "adapt.quality_switch on a CV filter.ekf refused (m2/s3 is not m2/s5)" 2 \
+  "node 'qs': cannot attach .* 3 spectral densities in m2/s3, per ENU axis" -- "$TF" validate "$TMP/qs_cv.yaml"
+
+# 3. A recorded log with invalid rows through every converter into every Cartesian filter, and
+# straight into every spherical one: the invalid rows are coasted and counted, never an error.
+awk 'BEGIN {
+  print "time,range,azimuth,elevation,valid";
+  pi = atan2(0, -1);
+  for (i = 0; i < 60; i++) {
+    t = i * 0.5; x = 6000 - 150 * t; y = 8000 + 50 * t; z = 1000;
+    r = sqrt(x * x + y * y + z * z);
+    az = atan2(x, y) * 180 / pi; el = atan2(z, sqrt(x * x + y * y)) * 180 / pi;
+    valid = (i % 10 == 7) ? 0 : 1;
+    printf "%.1f,%.3f,%.6f,%.6f,%d\n", t, r + ((i * 7) % 5 - 2), az + ((i * 3) % 5 - 2) * 1e-3, el, valid;
+  }
+}' > "$TMP/log.csv"
+invalid=$(awk -F, 'NR > 1 && $5 == 0' "$TMP/log.csv" | wc -l)
+for conv in convert.classical convert.debiased convert.unbiased convert.unbiased_modified; do
+  for filt in filter.kalman filter.decoupled; do
+    cat > "$TMP/coast.yaml" <<YAML
+pipeline: { name: coast, seed: 1, runs: 1 }
+nodes:
+  - id: log
+    type: source.csv
+    params: { path: log.csv, valid_column: valid, sigma_range: 3 m, sigma_azimuth: 1 mrad, sigma_elevation: 1 mrad }
+  - id: cm
+    type: $conv
+    input: log
+  - id: f
+    type: $filt
+    input: cm
+YAML
+    expect_run "$conv -> $filt coasts the $invalid invalid rows" 0 "^  coasted +$invalid$" -- "$TF" run "$TMP/coast.yaml" --no-progress
+  done
+done
+for filt in filter.ekf filter.ukf filter.ekf_spherical "filter.gain_transform"; do
+  extra=""
+  [ "$filt" = filter.gain_transform ] && extra="params: { singer_sigma: 5 m/s2 }"
+  cat > "$TMP/coast.yaml" <<YAML
+pipeline: { name: coast, seed: 1, runs: 1 }
+nodes:
+  - id: log
+    type: source.csv
+    params: { path: log.csv, valid_column: valid, sigma_range: 3 m, sigma_azimuth: 1 mrad, sigma_elevation: 1 mrad }
+  - id: f
+    type: $filt
+    input: log
+    $extra
+YAML
+  expect_run "$filt coasts the $invalid invalid rows" 0 "^  coasted +$invalid$" -- "$TF" run "$TMP/coast.yaml" --no-progress
+done
+
+# 4. The engine restores adapted process noise at every run: test.q_ramp doubles q at every step
+# and publishes the q it found; filter.kalman does not restore q itself. Every run's first
+# estimate must see the configured q (2), and the output must not depend on the thread count.
+{ radar_nodes; cat <<'YAML'
+  - id: cm
+    type: convert.classical
+    input: radar
+  - id: kf
+    type: filter.kalman
+    input: cm
+    params: { q: 2 m2/s3, init: explicit, initial_position: [6000, 8000, 1000], initial_sigma_position: 100 m,
+              initial_sigma_velocity: 200 m/s }   # initialised from the first measurement on
+  - id: ramp
+    type: test.q_ramp
+    attach_to: kf
+  - id: rows
+    type: sink.csv
+    inputs: [kf]
+    params: { precision: 17 }
+YAML
+} > "$TMP/ramp.yaml"
+expect_run "q_ramp pipeline runs (1 thread)" 0 "rows" -- "$TF" run "$TMP/ramp.yaml" --plugin-path "$TEST_PLUGINS" --threads 1 --no-progress --out "$TMP/t1"
+expect_run "q_ramp pipeline runs (2 threads)" 0 "rows" -- "$TF" run "$TMP/ramp.yaml" --plugin-path "$TEST_PLUGINS" --threads 2 --no-progress --out "$TMP/t2"
+head -n 1 "$TMP/t1/rows.csv" | grep -q ',ramp.q_seen$' || fail "sink.csv has no ramp.q_seen column: $(head -n 1 "$TMP/t1/rows.csv")"
+cmp -s "$TMP/t1/rows.csv" "$TMP/t2/rows.csv" || fail "q_ramp: output differs between --threads 1 and 2"
+# The first row of each run: the q seen before the first adaptation of that run.
+firsts=$(awk -F, 'NR > 1 && !seen[$1]++ { print $NF }' "$TMP/t1/rows.csv" | sort -u)
+[ "$firsts" = "2" ] || fail "q seen at the start of the runs: '$firsts', expected only the configured 2"
+runs=$(awk -F, 'NR > 1 { print $1 }' "$TMP/t1/rows.csv" | sort -u | wc -l)
+[ "$runs" -eq 4 ] || fail "expected 4 runs in rows.csv, found $runs"
+checks=$((checks + 1)); echo "ok: every run starts from the configured q, identical for 1 and 2 threads"
+
+finish
