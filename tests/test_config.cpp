@@ -26,7 +26,7 @@ ConfigError validate_error(const std::string& yaml) {
 }
 }  // namespace
 
-TEST_CASE("valid parameters come out in SI, defaults filled") {
+TEST_CASE("valid parameters come out in SI with defaults") {
   Value v = load_yaml_string("{ rate: 40 Hz, position: [1 km, 0, -2] }", "p.yaml");
   Params p = validate_params(specs(), v, "radar", v.loc);
   CHECK(p.real("rate") == 40.0);
@@ -37,7 +37,7 @@ TEST_CASE("valid parameters come out in SI, defaults filled") {
   CHECK(p.vec3("position")(0) == 1000.0);
 }
 
-TEST_CASE("parameter errors name the line, column and node") {
+TEST_CASE("parameter errors name line/column/node") {
   auto e = validate_error("rate: 40 Hz\nsigma_rnge: 3 m\n");
   CHECK(e.message().find("p.yaml:2:1") != std::string::npos);
   CHECK(e.message().find("node 'radar'") != std::string::npos);

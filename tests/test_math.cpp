@@ -12,7 +12,7 @@
 using namespace trackflow;
 constexpr double pi = std::numbers::pi;
 
-TEST_CASE("wrap_angle maps to (-pi, pi]") {
+TEST_CASE("wrap_angle maps to -pi exclusive to pi inclusive") {
   CHECK(wrap_angle(pi) == Approx(pi));
   CHECK(wrap_angle(-pi) == Approx(pi));
   CHECK(wrap_angle(3 * pi / 2) == Approx(-pi / 2));
@@ -21,7 +21,7 @@ TEST_CASE("wrap_angle maps to (-pi, pi]") {
   CHECK(wrap_angle(pi - 1e-12) - (-pi + 1e-12) > 0);  // no jump inside the range
 }
 
-TEST_CASE("spherical round trip in both conventions, and at the zenith") {
+TEST_CASE("spherical round trip: both conventions and zenith") {
   for (auto c : {AzimuthConvention::NorthClockwise, AzimuthConvention::XCounterClockwise}) {
     const Vec3 s(12e3, -2.9, 0.3);
     const Vec3 back = enu_to_spherical(spherical_to_enu(s(0), s(1), s(2), c), c);
@@ -37,7 +37,8 @@ TEST_CASE("spherical round trip in both conventions, and at the zenith") {
   CHECK(o.allFinite());
 }
 
-TEST_CASE("continuous-noise Q of CA is the white-jerk matrix of paper 000 eq 3.19") {
+// continuous-noise Q of CA is the white-jerk matrix of paper 000 eq 3.19
+TEST_CASE("CA continuous-noise Q is paper 000 eq 3.19") {
   const double T = 0.025, q = 2.0;
   const auto Q = ConstantAcceleration::axis_noise_continuous(T, q);
   CHECK(Q(0, 0) == Approx(q * std::pow(T, 5) / 20));
@@ -61,7 +62,8 @@ TEST_CASE("propagate equals F x") {
   CHECK((x - expected).norm() < 1e-12);
 }
 
-TEST_CASE("Joseph update keeps P symmetric positive definite and matches the textbook gain") {
+// Joseph update keeps P symmetric positive definite and matches the textbook gain
+TEST_CASE("Joseph update keeps P symmetric PD with textbook gain") {
   using M = ConstantVelocity;
   M::State x = M::State::Zero();
   M::Matrix P = M::Matrix::Identity() * 100.0;

@@ -25,7 +25,7 @@ Mat3 numerical_jacobian(double r, double az, double el, AzimuthConvention c) {
 
 }  // namespace
 
-TEST_CASE("line-of-sight PSDs: range as is, angles times (r cos el)^2 and r^2") {
+TEST_CASE("line-of-sight PSDs scale angles by range terms") {
   const ChannelPsd q{0.01, 1e-13, 2e-13};
   const double r = 140e3, el = 0.3;
   const Vec3 los = line_of_sight_psd(q, r, el);
@@ -34,7 +34,7 @@ TEST_CASE("line-of-sight PSDs: range as is, angles times (r cos el)^2 and r^2") 
   CHECK(los(2) == Approx(r * r * 2e-13));
 }
 
-TEST_CASE("ENU-axis PSDs are the diagonal of J diag(q) J' and keep its trace") {
+TEST_CASE("ENU-axis PSDs are diag of J diag(q) J'") {
   const ChannelPsd q{0.03, 4e-13, 1e-13};
   for (auto conv : {AzimuthConvention::NorthClockwise, AzimuthConvention::XCounterClockwise}) {
     for (double az : {0.0, 0.7, 2.5, -1.9}) {
@@ -52,7 +52,7 @@ TEST_CASE("ENU-axis PSDs are the diagonal of J diag(q) J' and keep its trace") {
   }
 }
 
-TEST_CASE("ENU-axis PSDs are exact when the line of sight lies along north") {
+TEST_CASE("ENU-axis PSDs are exact for a northward LOS") {
   // north_clockwise, az = 0, el = 0: range along y, azimuth along x, elevation along z.
   const ChannelPsd q{0.05, 1e-12, 3e-12};
   const double r = 100e3;
@@ -62,7 +62,7 @@ TEST_CASE("ENU-axis PSDs are exact when the line of sight lies along north") {
   CHECK(diag(2) == Approx(r * r * 3e-12));
 }
 
-TEST_CASE("noise_mismatch accepts a filter that offers what the adapter needs") {
+TEST_CASE("noise_mismatch accepts a matching filter") {
   MeasCov R = MeasCov::Zero(3, 3);
   double q[3] = {1, 1, 1};
   const NoiseHandles offered{{&R, MeasurementSpace::Spherical},
@@ -79,7 +79,7 @@ TEST_CASE("noise_mismatch accepts a filter that offers what the adapter needs") 
   CHECK(noise_mismatch(needs, offered, true).empty());
 }
 
-TEST_CASE("noise_mismatch names both sides of a wrong kind unit or space") {
+TEST_CASE("noise_mismatch names both sides") {
   MeasCov R = MeasCov::Zero(3, 3);
   double sigma[3] = {1, 1, 1};
   // filter.gain_transform's Singer sigma_m per ENU axis against a writer of jerk densities.

@@ -7,7 +7,8 @@
 
 using namespace trackflow;
 
-TEST_CASE("the same seed gives the same sequence; different nodes and runs differ") {
+// the same seed gives the same sequence; different nodes and runs differ
+TEST_CASE("same seed gives same sequence and nodes/runs differ") {
   Rng a(derive_seed(1, 0, "radar")), b(derive_seed(1, 0, "radar"));
   for (int i = 0; i < 100; ++i) CHECK(a.normal() == b.normal());
   CHECK(derive_seed(1, 0, "radar") != derive_seed(1, 1, "radar"));

@@ -70,7 +70,8 @@ struct Dwna {
 
 }  // namespace
 
-TEST_CASE("Kalata gains and the steady-state covariance equal the converged Kalman filter of the DWNA model") {
+// Kalata gains and the steady-state covariance equal the converged Kalman filter of the DWNA model
+TEST_CASE("Kalata gains and P equal the steady-state DWNA filter") {
   const double sigma_w = 7.0;
   for (double lambda : {0.05, 0.5, 2.0, 10.0}) {
     for (double T : {0.1, 1.0, 3.0}) {
@@ -100,7 +101,8 @@ TEST_CASE("Kalata gains and the steady-state covariance equal the converged Kalm
   }
 }
 
-TEST_CASE("gains are accepted exactly where the steady-state covariance is positive definite") {
+// gains are accepted exactly where the steady-state covariance is positive definite
+TEST_CASE("gains accepted exactly where steady-state P is PD") {
   for (double alpha : {0.05, 0.1, 0.5, 0.9, 0.99}) {
     const double b = alpha_beta::max_beta_for_covariance(alpha);
     for (double beta : {0.5 * b, 0.99 * b, 1.01 * b, 1.5 * b}) {
@@ -117,7 +119,8 @@ TEST_CASE("gains are accepted exactly where the steady-state covariance is posit
   CHECK_FALSE(alpha_beta::has_steady_state_covariance({0.5, alpha_beta::max_beta_for_covariance(0.5)}));
 }
 
-TEST_CASE("two-point start, then the alpha-beta recursion with the actual time step") {
+// two-point start, then the alpha-beta recursion with the actual time step
+TEST_CASE("two-point start then recursion with the actual time step") {
   const double alpha = 0.6, beta = 0.3;
   auto f = make("{alpha: 0.6, beta: 0.3}");
   Collector out;
@@ -167,7 +170,8 @@ TEST_CASE("two-point start, then the alpha-beta recursion with the actual time s
   CHECK(diag.warnings.empty());
 }
 
-TEST_CASE("default gains are alpha 0.5 and beta 0.2 and tracking_index gives the Kalata gains") {
+// default gains are alpha 0.5 and beta 0.2 and tracking_index gives the Kalata gains
+TEST_CASE("default gains and Kalata gains from tracking_index") {
   struct Case {
     std::string yaml;
     alpha_beta::Gains expected;
@@ -188,7 +192,8 @@ TEST_CASE("default gains are alpha 0.5 and beta 0.2 and tracking_index gives the
   }
 }
 
-TEST_CASE("a noiseless constant-velocity target is tracked exactly through irregular steps") {
+// a noiseless constant-velocity target is tracked exactly through irregular steps
+TEST_CASE("noiseless CV target tracked exactly over irregular steps") {
   auto f = make("{alpha: 0.3, beta: 0.05}");
   Collector out;
   out.attach_to(*f);
@@ -208,7 +213,8 @@ TEST_CASE("a noiseless constant-velocity target is tracked exactly through irreg
   }
 }
 
-TEST_CASE("Monte Carlo on a DWNA target: errors and NIS agree with the published covariance") {
+// Monte Carlo on a DWNA target: errors and NIS agree with the published covariance
+TEST_CASE("Monte Carlo DWNA target: errors and NIS match covariance") {
   const double T = 1.0, sigma_w = 10.0, lambda = 0.5, sigma_a = lambda * sigma_w / (T * T);
   const int runs = 1500, steps = 40;
   const Dwna model(T, sigma_a);
@@ -271,7 +277,7 @@ TEST_CASE("bad parameters are refused naming the parameter") {
   CHECK(message("{alpha: 0.5, beta: 0.2}") == "no error");
 }
 
-TEST_CASE("a spherical measurement is a configuration error naming the node") {
+TEST_CASE("spherical measurement is a config error naming the node") {
   auto f = make("{}", "my_ab");
   Diagnostics diag;
   f->start_run({0, 1, &diag});
@@ -285,7 +291,8 @@ TEST_CASE("a spherical measurement is a configuration error naming the node") {
   }
 }
 
-TEST_CASE("a time step of zero or less skips the update with a warning and invalid measurements coast") {
+// a time step of zero or less skips the update with a warning and invalid measurements coast
+TEST_CASE("non-positive time step skips update and invalid coasts") {
   auto f = make("{}", "ab");
   Collector out;
   out.attach_to(*f);

@@ -68,6 +68,11 @@ if [ -x "$plugin_build/test_alpha_beta" ]; then
   step "run the example plugin's own tests"
   ctest --test-dir "$plugin_build" --output-on-failure >"$log" 2>&1 || fail "the example plugin's tests failed"
   ok "$(grep -Eo '[0-9]+% tests passed.*' "$log" | head -n 1)"
+  step "every Catch2 test case of the example is one ctest entry"
+  printf '%s\t%s\n' "$plugin_build/test_alpha_beta" "alpha_beta:" >"$tmp/catch2_tests.txt"
+  bash "$repo/tests/cli/catch_count.sh" ctest "$plugin_build" "$tmp/catch2_tests.txt" >"$log" 2>&1 ||
+    fail "the example's Catch2 test cases and its ctest entries differ"
+  ok "$(grep -E 'test cases listed' "$log")"
 fi
 
 step "trackflow plugins --plugin-path <example build> lists the new type and the installed ones"

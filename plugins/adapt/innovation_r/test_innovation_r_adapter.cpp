@@ -94,7 +94,8 @@ Moments moments(const std::vector<Mat3>& xs) {
 
 }  // namespace
 
-TEST_CASE("R-hat converges to k^2 R when the true noise is k times the nominal, on filter.kalman and filter.decoupled") {
+// R-hat converges to k^2 R when the true noise is k times the nominal, on filter.kalman and filter.decoupled
+TEST_CASE("R-hat converges to k^2 R on kalman and decoupled") {
   const int runs = 200, steps = 400, window = 20;
   for (const char* type : {"filter.kalman", "filter.decoupled"}) {
     for (double k : {1.0, 3.0}) {
@@ -120,7 +121,8 @@ TEST_CASE("R-hat converges to k^2 R when the true noise is k times the nominal, 
   }
 }
 
-TEST_CASE("post_fit_term subtract (eq 28 as printed) converges below R by about twice the posterior variance") {
+// post_fit_term subtract (eq 28 as printed) converges below R by about twice the posterior variance
+TEST_CASE("post_fit_term subtract converges below R") {
   // add tends to R; subtract to E[dz dz'] - H P+ H' = R - 2 H P+ H' (to first order in H P+ H' / R).
   const int runs = 100, steps = 400;
   Attached add("filter.kalman", "{ q: 1 m2/s3 }", "{}");
@@ -141,7 +143,8 @@ TEST_CASE("post_fit_term subtract (eq 28 as printed) converges below R by about 
   }
 }
 
-TEST_CASE("the floor holds on the filter's R when residuals vanish") {
+// the floor holds on the filter's R when residuals vanish
+TEST_CASE("the floor holds on R when residuals vanish") {
   for (const char* term : {"add", "subtract"}) {
     INFO(term);
     Attached s("filter.decoupled", "{ q: 0.001 m2/s3 }",
@@ -197,7 +200,8 @@ TEST_CASE("incompatibility names what is missing") {
   CHECK_THROWS_WITH(test::make("adapt.innovation_r", "{ window: 0 }"), Catch::Contains("window"));
 }
 
-TEST_CASE("in a pipeline the adapter drives filter.kalman and filter.decoupled, deterministically for any thread count") {
+// in a pipeline the adapter drives filter.kalman and filter.decoupled, deterministically for any thread count
+TEST_CASE("pipeline with kalman and decoupled is deterministic") {
   const std::string yaml = R"(
 pipeline: { name: adapter_pipeline, seed: 3, runs: 12 }
 nodes:

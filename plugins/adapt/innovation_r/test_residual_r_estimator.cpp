@@ -27,7 +27,8 @@ Mat3 anisotropic_nominal() {
 
 }  // namespace
 
-TEST_CASE("the moving average follows eq 31 in closed form for a constant single-step estimate") {
+// the moving average follows eq 31 in closed form for a constant single-step estimate
+TEST_CASE("moving average follows eq 31 in closed form") {
   EstimatorSettings s;
   s.window = 7;
   s.warmup = 0;
@@ -63,7 +64,8 @@ TEST_CASE("eq 28 as printed subtracts the posterior covariance") {
   CHECK(est.estimate()(1, 1) == Approx(1e-18).margin(1e-20));
 }
 
-TEST_CASE("warm-up: the estimate is the latest nominal R until `warmup` residuals have been seen") {
+// warm-up: the estimate is the latest nominal R until `warmup` residuals have been seen
+TEST_CASE("warm-up returns the nominal R") {
   EstimatorSettings s;
   s.warmup = 3;
   ResidualREstimator est(s);
@@ -80,7 +82,7 @@ TEST_CASE("warm-up: the estimate is the latest nominal R until `warmup` residual
   CHECK(est.estimate()(0, 0) > 4.0 * N(0, 0));
 }
 
-TEST_CASE("apply_floor raises only the eigenvalues below the floors") {
+TEST_CASE("apply_floor raises only eigenvalues below floors") {
   const Mat3 N = anisotropic_nominal();
   SECTION("above both floors: unchanged") {
     Mat3 R = 2.0 * N;
@@ -108,7 +110,8 @@ TEST_CASE("apply_floor raises only the eigenvalues below the floors") {
   }
 }
 
-TEST_CASE("the floor keeps R-hat positive definite against adversarial residuals") {
+// the floor keeps R-hat positive definite against adversarial residuals
+TEST_CASE("floor keeps R-hat PD against adversarial residuals") {
   const Mat3 N = anisotropic_nominal();
   Rng rng(99);
   for (bool add : {true, false}) {

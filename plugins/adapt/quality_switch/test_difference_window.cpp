@@ -14,7 +14,7 @@ using adapt::DifferenceWindow;
 using adapt::Grade;
 using adapt::grade_of;
 
-TEST_CASE("RMS of the last n differences, by hand") {
+TEST_CASE("RMS of the last n differences by hand") {
   DifferenceWindow w(3);
   const double z[] = {1.0, 3.0, 2.0, 6.0, 4.0};
   w.add(z[0]);
@@ -44,7 +44,7 @@ TEST_CASE("reset: no difference is taken across the gap") {
   CHECK(w.rms() == Approx(3.0));
 }
 
-TEST_CASE("azimuth differences are wrapped across the ±pi seam") {
+TEST_CASE("azimuth differences wrap across the pi seam") {
   constexpr double pi = std::numbers::pi;
   DifferenceWindow az(2, /*wrap=*/true), plain(2);
   for (double z : {pi - 0.01, -pi + 0.01, -pi + 0.03}) {
@@ -55,7 +55,7 @@ TEST_CASE("azimuth differences are wrapped across the ±pi seam") {
   CHECK(plain.rms() > 4.0);
 }
 
-TEST_CASE("detrend removes a constant rate; the plain RMS keeps it") {
+TEST_CASE("detrend removes a constant rate and RMS keeps it") {
   DifferenceWindow plain(4), centred(4, false, true);
   // A ramp of slope 5 per sample plus +-1 alternating: differences 5 +- 2 alternating.
   for (int i = 0; i < 9; ++i) {
@@ -68,7 +68,8 @@ TEST_CASE("detrend removes a constant rate; the plain RMS keeps it") {
   CHECK(centred.rms() == Approx(2.0));
 }
 
-TEST_CASE("white noise: E[RMSE^2] = 2 sigma^2, detrended 2 sigma^2 (1 - 1/n^2), whatever the rate") {
+// white noise: E[RMSE^2] = 2 sigma^2, detrended 2 sigma^2 (1 - 1/n^2), whatever the rate
+TEST_CASE("white noise RMSE^2 expectation with any rate") {
   const int n = 10, windows = 20000;
   const double sigma = 0.3, rate = 7.0;
   Rng rng(11);
@@ -98,7 +99,8 @@ TEST_CASE("white noise: E[RMSE^2] = 2 sigma^2, detrended 2 sigma^2 (1 - 1/n^2), 
   CHECK(se_plain < 0.01 * 2.0 * s2);
 }
 
-TEST_CASE("grade thresholds: BEST up to l1 M inclusive, NORMAL up to l2 M inclusive, WORST beyond") {
+// grade thresholds: BEST up to l1 M inclusive, NORMAL up to l2 M inclusive, WORST beyond
+TEST_CASE("grade thresholds l1 M and l2 M are inclusive") {
   const double M = 2.2254, inf = std::numeric_limits<double>::infinity();
   CHECK(grade_of(0.0, M, 1, 2) == Grade::Best);
   CHECK(grade_of(0.5 * M, M, 1, 2) == Grade::Best);

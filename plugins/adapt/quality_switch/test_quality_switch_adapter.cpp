@@ -105,7 +105,8 @@ Vec3 expected_enu_q(const Vec3& rel, double q_range, double q_az, double q_el) {
 
 }  // namespace
 
-TEST_CASE("the adapter writes the graded rows' R and q into filter.ekf (read back through noise())") {
+// the adapter writes the graded rows' R and q into filter.ekf (read back through noise())
+TEST_CASE("adapter writes graded R and q into filter.ekf") {
   Attached s;
   // Range steps of 0.5 m (RMSE 0.5 <= 1 m: BEST), azimuth steps of 1.5 mrad (NORMAL), elevation
   // steps of 3 mrad (WORST).
@@ -140,7 +141,8 @@ TEST_CASE("the adapter writes the graded rows' R and q into filter.ekf (read bac
   CHECK(sum.find("ungraded_steps")->value == 2);
 }
 
-TEST_CASE("grades at the thresholds: RMSE = M is BEST, = 2M is NORMAL, just above 2M is WORST") {
+// grades at the thresholds: RMSE = M is BEST, = 2M is NORMAL, just above 2M is WORST
+TEST_CASE("grades exactly at the M and 2M thresholds") {
   Attached s;
   // Window 2, M = 1 m. Range differences chosen so that the RMS of the last two is exact.
   const double r[] = {0, 1, 2,        // d = 1, 1: RMSE 1 = M                 -> BEST (k = 2)
@@ -161,7 +163,8 @@ TEST_CASE("grades at the thresholds: RMSE = M is BEST, = 2M is NORMAL, just abov
   }
 }
 
-TEST_CASE("the table follows the measurement's mode; unknown_mode picks the table for neither") {
+// the table follows the measurement's mode; unknown_mode picks the table for neither
+TEST_CASE("table follows the measurement mode") {
   for (const char* unknown : {"beacon", "skin"}) {
     Attached s(std::string(kAdapterParams).substr(0, std::string(kAdapterParams).size() - 1) + ", unknown_mode: " +
                unknown + " }");
@@ -183,7 +186,8 @@ TEST_CASE("the table follows the measurement's mode; unknown_mode picks the tabl
   }
 }
 
-TEST_CASE("an invalid sample: the filter coasts, the grade is held, no difference is taken across it") {
+// an invalid sample: the filter coasts, the grade is held, no difference is taken across it
+TEST_CASE("invalid sample coasts and holds the grade") {
   Attached s;
   // BEST with 0.5 m steps, then an unlocked sample, then the track resumes 50 m further on.
   for (int k = 0; k < 6; ++k) s.step(meas(0.025 * k, kR0 + 0.5 * k));
@@ -213,7 +217,8 @@ TEST_CASE("an invalid sample: the filter coasts, the grade is held, no differenc
   CHECK(sum.find("mean_rmse_range")->value == Approx(0.5));
 }
 
-TEST_CASE("a run that starts unlocked gets the filter's own q back, not the previous run's") {
+// a run that starts unlocked gets the filter's own q back, not the previous run's
+TEST_CASE("unlocked run start restores the filter's own q") {
   Attached s;
   for (int k = 0; k < 5; ++k) s.step(meas(0.025 * k, kR0 + 0.5 * k));
   REQUIRE(s.f->noise().process.values[0] != 7.0);  // adapted
@@ -225,7 +230,7 @@ TEST_CASE("a run that starts unlocked gets the filter's own q back, not the prev
   CHECK(s.f->noise().process.values[0] != 7.0);  // geometry known: the table's again
 }
 
-TEST_CASE("to a line-of-sight q the adapter writes [q_r, (r cos el)^2 q_az, r^2 q_el] at the published estimate") {
+TEST_CASE("a line-of-sight q gets channel PSDs scaled at the estimate") {
   struct StubFilter : Filter {
     MeasCov R = MeasCov::Identity(3, 3);
     double q[3] = {-1, -1, -1};
@@ -266,7 +271,8 @@ TEST_CASE("to a line-of-sight q the adapter writes [q_r, (r cos el)^2 q_az, r^2 
   CHECK(grade(out.estimates.back(), 0) == -1);
 }
 
-TEST_CASE("incompatible filters and bad tables are refused with the reason") {
+// incompatible filters and bad tables are refused with the reason
+TEST_CASE("incompatible filters and bad tables are refused") {
   auto adapter = test::make("adapt.quality_switch");
   auto* a = dynamic_cast<Adapter*>(adapter.get());
   auto kalman = test::make("filter.kalman");
@@ -291,7 +297,8 @@ TEST_CASE("incompatible filters and bad tables are refused with the reason") {
                     Catch::Contains("q_angle"));
 }
 
-TEST_CASE("in a pipeline: skin and unlocked windows are counted, results do not depend on the thread count") {
+// in a pipeline: skin and unlocked windows are counted, results do not depend on the thread count
+TEST_CASE("pipeline counts windows independent of threads") {
   const std::string yaml = R"(
 pipeline: { name: quality_pipeline, seed: 5, runs: 6 }
 nodes:

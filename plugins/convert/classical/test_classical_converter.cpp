@@ -21,7 +21,8 @@ Measurement spherical(double r, double az, double el, AzimuthConvention c) {
 }
 }  // namespace
 
-TEST_CASE("converted position matches the azimuth convention and adds the sensor position") {
+// converted position matches the azimuth convention and adds the sensor position
+TEST_CASE("position follows azimuth convention and sensor") {
   auto conv = test::make("convert.classical");
   test::Collector out;
   out.attach_to(*conv);
@@ -36,7 +37,8 @@ TEST_CASE("converted position matches the azimuth convention and adds the sensor
   CHECK(out.measurements[0].frame == Frame::Cartesian);
 }
 
-TEST_CASE("covariance is J R J' with J equal to a numerical Jacobian") {
+// covariance is J R J' with J equal to a numerical Jacobian
+TEST_CASE("covariance is J R J' with a numerical J") {
   for (auto c : {AzimuthConvention::NorthClockwise, AzimuthConvention::XCounterClockwise}) {
     const double r = 25e3, az = 2.3, el = 0.4;
     const Mat3 J = spherical_to_enu_jacobian(r, az, el, c);

@@ -28,7 +28,8 @@ std::map<std::string, StudyRow> study(const StudyGeometry& g) {
 }
 }  // namespace
 
-TEST_CASE("geometry A (r σ²/σ_r ≈ 12): classical fails, modified unbiased is consistent, unbiased is unbiased") {
+// geometry A (r σ²/σ_r ≈ 12): classical fails, modified unbiased is consistent, unbiased is unbiased
+TEST_CASE("geometry A (large bias): classical fails") {
   const StudyGeometry g = standard_geometries().at(0);
   REQUIRE(g.nonlinearity() > 10.0);
   auto rows = study(g);
@@ -63,7 +64,8 @@ TEST_CASE("geometry A (r σ²/σ_r ≈ 12): classical fails, modified unbiased i
   CHECK(debiased.nees_per_dim < 2.0);
 }
 
-TEST_CASE("geometry B (r σ²/σ_r = 0.001): every converter is consistent") {
+// geometry B (r σ²/σ_r = 0.001): every converter is consistent
+TEST_CASE("geometry B (small bias): all are consistent") {
   const StudyGeometry g = standard_geometries().at(1);
   REQUIRE(g.nonlinearity() < 0.01);
   auto rows = study(g);

@@ -14,7 +14,8 @@ const Vec3 kSigmas(30.0, 0.15, 0.10);
 
 // Lerro & Bar-Shalom's definitions: bias given the truth b(t) = E[p(m') | t] - p(t), averaged
 // over the truth given the measurement and subtracted; covariance E_t|m[ Cov[p(m') | t] ].
-TEST_CASE("mean and covariance are the average true bias and covariance (nested cubature), both conventions") {
+// mean and covariance are the average true bias and covariance (nested cubature), both conventions
+TEST_CASE("mean and covariance match nested cubature") {
   auto conv = make(kType);
   OneShot out;
   for (auto c : {AzimuthConvention::NorthClockwise, AzimuthConvention::XCounterClockwise}) {
@@ -32,7 +33,8 @@ TEST_CASE("mean and covariance are the average true bias and covariance (nested 
   }
 }
 
-TEST_CASE("range-rate cross-covariance is the average true covariance of (p(m), range rate) (cubature)") {
+// range-rate cross-covariance is the average true covariance of (p(m), range rate) (cubature)
+TEST_CASE("range-rate cross-covariance matches cubature") {
   auto conv = make(kType);
   OneShot out;
   for (auto c : {AzimuthConvention::NorthClockwise, AzimuthConvention::XCounterClockwise}) {
@@ -56,7 +58,7 @@ TEST_CASE("range-rate cross-covariance is the average true covariance of (p(m), 
 // In the horizontal plane with no elevation error the 3-D conversion must reduce to Lerro &
 // Bar-Shalom's published 2-D expressions (azimuth θ from x toward y), written here in their
 // cosh/sinh form, independently of conversion_moments.hpp.
-TEST_CASE("reduces to Lerro & Bar-Shalom's 2-D debiased expressions") {
+TEST_CASE("reduces to Lerro and Bar-Shalom 2-D expressions") {
   auto conv = make(kType);
   OneShot out;
   const double r = 15e3, th = 0.9, sr = 20.0, st = 0.15;
@@ -76,7 +78,8 @@ TEST_CASE("reduces to Lerro & Bar-Shalom's 2-D debiased expressions") {
   CHECK(relative_difference(Mat3(got.covariance), R) < 1e-9);
 }
 
-TEST_CASE("shared behaviour: pass-through, bad data, small-error limit, azimuth conventions") {
+// shared behaviour: pass-through, bad data, small-error limit, azimuth conventions
+TEST_CASE("shared converter behaviour") {
   check_pass_through(kType);
   check_bad_data(kType);
   check_small_error_limit(kType);

@@ -19,7 +19,8 @@ Vec3 mo_estimate(const Vec3& m, AzimuthConvention c) {
 }
 }  // namespace
 
-TEST_CASE("the converted mean is unbiased given the true position (cubature over the measurement error)") {
+// the converted mean is unbiased given the true position (cubature over the measurement error)
+TEST_CASE("mean is unbiased given the true position") {
   auto conv = make(kType);
   OneShot out;
   for (auto c : {AzimuthConvention::NorthClockwise, AzimuthConvention::XCounterClockwise}) {
@@ -39,7 +40,8 @@ TEST_CASE("the converted mean is unbiased given the true position (cubature over
   }
 }
 
-TEST_CASE("covariance is the truth-conditioned covariance averaged over the truth given the measurement (cubature)") {
+// covariance is the truth-conditioned covariance averaged over the truth given the measurement (cubature)
+TEST_CASE("covariance is the averaged truth-conditioned one") {
   auto conv = make(kType);
   OneShot out;
   for (auto c : {AzimuthConvention::NorthClockwise, AzimuthConvention::XCounterClockwise}) {
@@ -53,7 +55,8 @@ TEST_CASE("covariance is the truth-conditioned covariance averaged over the trut
   }
 }
 
-TEST_CASE("range-rate cross-covariance is the averaged truth-conditioned covariance (cubature)") {
+// range-rate cross-covariance is the averaged truth-conditioned covariance (cubature)
+TEST_CASE("range-rate cross-covariance matches cubature") {
   auto conv = make(kType);
   OneShot out;
   for (auto c : {AzimuthConvention::NorthClockwise, AzimuthConvention::XCounterClockwise}) {
@@ -100,7 +103,8 @@ TEST_CASE("matches Mo et al.'s eq 11 (x_counterclockwise)") {
   CHECK(relative_difference(Mat3(got.covariance), R) < 1e-9);
 }
 
-TEST_CASE("shared behaviour: pass-through, bad data, small-error limit, azimuth conventions") {
+// shared behaviour: pass-through, bad data, small-error limit, azimuth conventions
+TEST_CASE("shared converter behaviour") {
   check_pass_through(kType);
   check_bad_data(kType);
   check_small_error_limit(kType);

@@ -13,7 +13,8 @@ const Vec3 kSensor(100.0, -50.0, 3.0);
 const Vec3 kSigmas(30.0, 0.15, 0.10);
 }  // namespace
 
-TEST_CASE("mean and covariance are the posterior moments of the true position (cubature), both conventions") {
+// mean and covariance are the posterior moments of the true position (cubature), both conventions
+TEST_CASE("mean and covariance are posterior moments") {
   auto conv = make(kType);
   OneShot out;
   for (auto c : {AzimuthConvention::NorthClockwise, AzimuthConvention::XCounterClockwise}) {
@@ -30,7 +31,8 @@ TEST_CASE("mean and covariance are the posterior moments of the true position (c
   }
 }
 
-TEST_CASE("range-rate cross-covariance is the posterior covariance of (position, range rate) (cubature)") {
+// range-rate cross-covariance is the posterior covariance of (position, range rate) (cubature)
+TEST_CASE("range-rate cross-covariance is posterior") {
   auto conv = make(kType);
   OneShot out;
   for (auto c : {AzimuthConvention::NorthClockwise, AzimuthConvention::XCounterClockwise}) {
@@ -53,7 +55,8 @@ TEST_CASE("range-rate cross-covariance is the posterior covariance of (position,
 
 // Duan, Han & Li (2004) give the modified conversion element by element for azimuth measured
 // from x toward y (β) and elevation η; transcribed independently of conversion_moments.hpp.
-TEST_CASE("matches Duan, Han & Li's element-wise expressions (x_counterclockwise)") {
+// matches Duan, Han & Li's element-wise expressions (x_counterclockwise)
+TEST_CASE("matches Duan Han and Li element-wise") {
   auto conv = make(kType);
   OneShot out;
   const double r = 15e3, b = 0.9, e = 0.35, sr2 = 400.0, sb2 = 0.02, se2 = 0.01;
@@ -75,7 +78,8 @@ TEST_CASE("matches Duan, Han & Li's element-wise expressions (x_counterclockwise
   CHECK(relative_difference(Mat3(got.covariance), R) < 1e-9);
 }
 
-TEST_CASE("the covariance stays positive definite and free of cancellation at tiny angle errors") {
+// the covariance stays positive definite and free of cancellation at tiny angle errors
+TEST_CASE("covariance stays PD at tiny angle errors") {
   auto conv = make(kType);
   OneShot out;
   // 1 µrad at 1000 km: the angle part of the variance is 1 m², r² is 1e12 m².
@@ -87,14 +91,16 @@ TEST_CASE("the covariance stays positive definite and free of cancellation at ti
   CHECK(Eigen::LLT<Mat3>(Mat3(got.covariance)).info() == Eigen::Success);
 }
 
-TEST_CASE("shared behaviour: pass-through, bad data, small-error limit, azimuth conventions") {
+// shared behaviour: pass-through, bad data, small-error limit, azimuth conventions
+TEST_CASE("shared converter behaviour") {
   check_pass_through(kType);
   check_bad_data(kType);
   check_small_error_limit(kType);
   check_convention_equivalence(kType);
 }
 
-TEST_CASE("correlated (r, az, el) errors are converted with their variances and reported, not ignored silently") {
+// correlated (r, az, el) errors are converted with their variances and reported, not ignored silently
+TEST_CASE("correlated spherical errors are reported") {
   auto conv = trackflow::test::make("convert.unbiased_modified");
   trackflow::test::Collector out;
   out.attach_to(*conv);

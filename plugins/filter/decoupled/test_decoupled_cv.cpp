@@ -52,7 +52,8 @@ double rel(const Eigen::MatrixXd& a, const Eigen::MatrixXd& b) { return (a - b).
 
 }  // namespace
 
-TEST_CASE("line-of-sight frame is a rotation that diagonalises the classical converted covariance") {
+// line-of-sight frame is a rotation that diagonalises the classical converted covariance
+TEST_CASE("LOS frame rotation diagonalises converted R") {
   Rng rng(11);
   for (int k = 0; k < 200; ++k) {
     const double r = 100.0 + 50e3 * rng.uniform();
@@ -83,7 +84,8 @@ TEST_CASE("line-of-sight frame is a rotation that diagonalises the classical con
   CHECK(D == Mat3::Identity());
 }
 
-TEST_CASE("decoupled gain equals the full Kalman gain when R is diagonal in the decoupled frame") {
+// decoupled gain equals the full Kalman gain when R is diagonal in the decoupled frame
+TEST_CASE("gain equals full Kalman gain for diagonal R") {
   Rng rng(5);
   for (int k = 0; k < 100; ++k) {
     DecoupledCv f = random_state(rng);
@@ -111,7 +113,9 @@ TEST_CASE("decoupled gain equals the full Kalman gain when R is diagonal in the 
   }
 }
 
-TEST_CASE("with R correlated in the decoupled frame the gain uses its diagonal, an error first order in the correlation") {
+// with R correlated in the decoupled frame the gain uses its diagonal, an error first order in the
+// correlation
+TEST_CASE("correlated R: gain error is first order") {
   Rng rng(8);
   for (int k = 0; k < 50; ++k) {
     DecoupledCv f = random_state(rng);
@@ -138,7 +142,8 @@ TEST_CASE("with R correlated in the decoupled frame the gain uses its diagonal, 
   }
 }
 
-TEST_CASE("prediction of the per-axis blocks equals F P F' + Q of the Cartesian covariance (isotropic Q)") {
+// prediction of the per-axis blocks equals F P F' + Q of the Cartesian covariance (isotropic Q)
+TEST_CASE("per-axis prediction equals Cartesian F P F' + Q") {
   Rng rng(3);
   DecoupledCv f = random_state(rng);
   Mat6 P0;
@@ -156,7 +161,9 @@ TEST_CASE("prediction of the per-axis blocks equals F P F' + Q of the Cartesian 
   CHECK((f.x - F * x0).norm() < 1e-12 * x0.norm());
 }
 
-TEST_CASE("reframing is exact for axis permutations, keeps the trace, and keeps the block diagonal of the rotated covariance") {
+// reframing is exact for axis permutations, keeps the trace, and keeps the block diagonal of the rotated
+// covariance
+TEST_CASE("reframing keeps trace and rotated block diagonal") {
   Rng rng(21);
   DecoupledCv f = random_state(rng);
   Mat6 P0;
@@ -184,7 +191,8 @@ TEST_CASE("reframing is exact for axis permutations, keeps the trace, and keeps 
   CHECK(P2.trace() == Approx(P0.trace()).epsilon(1e-12));
 }
 
-TEST_CASE("an R with a negative variance in the decoupled frame is refused and changes nothing") {
+// an R with a negative variance in the decoupled frame is refused and changes nothing
+TEST_CASE("negative decoupled variance in R is refused") {
   Rng rng(2);
   DecoupledCv f = random_state(rng);
   const DecoupledCv before = f;

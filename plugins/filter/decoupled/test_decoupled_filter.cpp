@@ -56,7 +56,8 @@ bool symmetric_psd(const Mat6& P) {
 
 }  // namespace
 
-TEST_CASE("decoupled filter reproduces filter.kalman when R is diagonal in a line of sight that does not turn") {
+// decoupled filter reproduces filter.kalman when R is diagonal in a line of sight that does not turn
+TEST_CASE("reproduces filter.kalman for a fixed LOS") {
   auto dkf = test::make("filter.decoupled", "{ q: 0.5 m2/s3 }");
   auto kf = test::make("filter.kalman", "{ q: 0.5 m2/s3 }");
   test::Collector dout, kout;
@@ -100,7 +101,8 @@ TEST_CASE("decoupled filter reproduces filter.kalman when R is diagonal in a lin
 // a few seconds and the cross-range noise (5 m) is larger than the range noise (2 m), so the
 // decoupling is an approximation. The truth has the white acceleration the filters assume, so the
 // full Kalman filter on the same converted measurements is the optimal reference.
-TEST_CASE("on a crossing target the decoupled filter stays close to the full Kalman filter in accuracy and consistency") {
+// on a crossing target the decoupled filter stays close to the full Kalman filter in accuracy and consistency
+TEST_CASE("crossing target: close to the full Kalman filter") {
   const double q = 0.5, T = 0.1;
   auto reproject = test::make("filter.decoupled", "{ q: 0.5 m2/s3 }");
   auto carry = test::make("filter.decoupled", "{ q: 0.5 m2/s3, frame_change: carry }");
@@ -154,7 +156,8 @@ TEST_CASE("on a crossing target the decoupled filter stays close to the full Kal
   }
 }
 
-TEST_CASE("published covariance stays symmetric positive semi-definite over a long run with a turning line of sight") {
+// published covariance stays symmetric positive semi-definite over a long run with a turning line of sight
+TEST_CASE("covariance stays symmetric PSD on a long run") {
   for (const char* params : {"{ q: 0.01 m2/s3 }", "{ q: 100 m2/s3, frame_change: carry }", "{ sigma_accel: 3 m/s2 }"}) {
     INFO(params);
     auto dkf = test::make("filter.decoupled", params);
@@ -185,7 +188,7 @@ TEST_CASE("published covariance stays symmetric positive semi-definite over a lo
   }
 }
 
-TEST_CASE("an invalid measurement makes the decoupled filter coast") {
+TEST_CASE("an invalid measurement makes the filter coast") {
   auto dkf = test::make("filter.decoupled", "{ q: 1 m2/s3 }");
   test::Collector out;
   out.attach_to(*dkf);
@@ -206,7 +209,9 @@ TEST_CASE("an invalid measurement makes the decoupled filter coast") {
   CHECK(coast.enu_covariance(0, 0) > out.estimates[4].enu_covariance(0, 0));
 }
 
-TEST_CASE("filter.decoupled: wrong inputs and parameters are clear errors, and R is exposed in Cartesian position space") {
+// filter.decoupled: wrong inputs and parameters are clear errors, and R is exposed in Cartesian position
+// space
+TEST_CASE("wrong inputs are errors and R is Cartesian") {
   auto dkf = test::make("filter.decoupled");
   Diagnostics d;
   dkf->start_run({0, 1, &d});
@@ -224,7 +229,8 @@ TEST_CASE("filter.decoupled: wrong inputs and parameters are clear errors, and R
   CHECK(h.process.count == 1);
 }
 
-TEST_CASE("a measurement noise that is not a covariance is refused with a warning, never a NaN") {
+// a measurement noise that is not a covariance is refused with a warning, never a NaN
+TEST_CASE("non-covariance measurement noise is refused") {
   auto dkf = test::make("filter.decoupled");
   test::Collector out;
   out.attach_to(*dkf);

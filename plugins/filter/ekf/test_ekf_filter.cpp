@@ -67,7 +67,8 @@ struct ReferenceEkf {
 
 }  // namespace
 
-TEST_CASE("CV EKF agrees step by step with a textbook EKF, with and without range rate, both conventions") {
+// CV EKF agrees step by step with a textbook EKF, with and without range rate, both conventions
+TEST_CASE("CV EKF agrees step by step with a textbook EKF") {
   for (auto c : {AzimuthConvention::NorthClockwise, AzimuthConvention::XCounterClockwise})
     for (bool rr : {false, true}) {
       INFO("convention " << int(c) << " range rate " << rr);
@@ -127,7 +128,8 @@ TEST_CASE("CV EKF agrees step by step with a textbook EKF, with and without rang
     }
 }
 
-TEST_CASE("CV EKF is consistent over 200 Monte Carlo runs (NEES at the last step, NIS over all steps)") {
+// CV EKF is consistent over 200 Monte Carlo runs (NEES at the last step, NIS over all steps)
+TEST_CASE("CV EKF is consistent over 200 Monte Carlo runs") {
   const int runs = 200, steps = 40;
   const double T = 0.5, q = 1.0;
   const Eigen::Matrix2d Qa = ConstantVelocity::axis_noise_continuous(T, q);
@@ -197,7 +199,8 @@ TEST_CASE("Singer EKF is consistent on a Singer target over 150 runs") {
   CHECK(anees < hi);
 }
 
-TEST_CASE("CA model tracks a constantly accelerating target, initialised by two_point or paper000") {
+// CA model tracks a constantly accelerating target, initialised by two_point or paper000
+TEST_CASE("CA model tracks an accelerating target") {
   for (const char* init : {"two_point", "paper000"}) {
     INFO("init " << init);
     Run run(std::string("{ motion: constant_acceleration, q_jerk: 0.01 m2/s5, init: ") + init + " }");
@@ -227,7 +230,8 @@ TEST_CASE("CA model tracks a constantly accelerating target, initialised by two_
   }
 }
 
-TEST_CASE("paper000 init: state from finite differences of converted positions, per-axis P0 from sigma and T") {
+// paper000 init: state from finite differences of converted positions, per-axis P0 from sigma and T
+TEST_CASE("paper000 init: finite-difference state and per-axis P0") {
   Run run("{ motion: constant_acceleration, init: paper000 }");
   const double T = 0.025;
   Vec3 z[3];
@@ -295,7 +299,8 @@ TEST_CASE("range rate lowers the velocity error") {
   CHECK(radial_use < 0.5 * radial_ignore);
 }
 
-TEST_CASE("an invalid measurement makes the filter coast: prediction only, covariance grows") {
+// an invalid measurement makes the filter coast: prediction only, covariance grows
+TEST_CASE("an invalid measurement makes the filter coast") {
   Run run("{}");
   const Vec3 v(100, 0, 0);
   for (int k = 0; k < 6; ++k) run.feed(radar(k, Vec3(5e3 + 100.0 * k, 5e3, 500), v, Vec3::Zero(), RadarNoise{}, nullptr, false));
@@ -334,7 +339,8 @@ TEST_CASE("a measurement older than the track is skipped and counted") {
   CHECK(run.diag.skips[0].node == "ekf");
 }
 
-TEST_CASE("a target passing due south (north_clockwise) or due west (x_counterclockwise) gives no 2 pi innovation") {
+// a target passing due south (north_clockwise) or due west (x_counterclockwise) gives no 2 pi innovation
+TEST_CASE("crossing the azimuth cut gives no 2 pi innovation") {
   for (auto c : {AzimuthConvention::NorthClockwise, AzimuthConvention::XCounterClockwise}) {
     Run run("{ q: 1 m2/s3 }");
     Rng rng(9);
@@ -361,7 +367,8 @@ TEST_CASE("a target passing due south (north_clockwise) or due west (x_countercl
   }
 }
 
-TEST_CASE("a pass straight over the radar stays finite with a symmetric positive-definite covariance") {
+// a pass straight over the radar stays finite with a symmetric positive-definite covariance
+TEST_CASE("a pass straight overhead stays finite and PD") {
   for (double offset : {0.0, 0.3, 3.0, 30.0}) {
     INFO("horizontal miss distance " << offset << " m");
     Run run("{ motion: constant_acceleration, q_jerk: 1 m2/s5 }");
@@ -394,7 +401,7 @@ TEST_CASE("a pass straight over the radar stays finite with a symmetric positive
   }
 }
 
-TEST_CASE("explicit initial state: the first measurement already updates") {
+TEST_CASE("explicit initial state: first measurement updates") {
   Run run("{ init: explicit, initial_position: [5 km, 5 km, 500 m], initial_velocity: [100, 0, 0], "
           "initial_sigma_position: 100 m, initial_sigma_velocity: 50 m/s }");
   const Estimate& e = run.feed(radar(3.0, Vec3(5e3, 5e3, 500), Vec3(100, 0, 0), Vec3::Zero(), RadarNoise{}, nullptr, false));
@@ -404,7 +411,8 @@ TEST_CASE("explicit initial state: the first measurement already updates") {
   CHECK(e.enu_covariance(0, 0) < 100.0 * 100.0);
 }
 
-TEST_CASE("noise handles: R in spherical space, per-axis q that the prediction follows") {
+// noise handles: R in spherical space, per-axis q that the prediction follows
+TEST_CASE("noise handles: spherical R and per-axis q") {
   auto make = [] { return Run("{ q: 1 m2/s3 }"); };
   Run a = make(), b = make();
   auto* fa = dynamic_cast<Filter*>(a.filter.get());

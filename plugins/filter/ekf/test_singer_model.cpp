@@ -76,7 +76,8 @@ double max_rel_entry(const Eigen::Matrix3d& got, const Eigen::Matrix3d& ref) {
 
 }  // namespace
 
-TEST_CASE("Singer F and Q equal the Van Loan exponential for tiny to large alpha T") {
+// Singer F and Q equal the Van Loan exponential for tiny to large alpha T
+TEST_CASE("Singer F and Q equal the Van Loan exponential") {
   for (double T : {0.025, 1.0, 10.0})
     for (double x : {1e-9, 1e-6, 1e-3, 0.05, 0.3, 0.4999, 0.5001, 1.0, 3.0, 20.0, 300.0}) {
       const double alpha = x / T;
@@ -100,7 +101,8 @@ TEST_CASE("Singer series and closed form meet at the switch point") {
                       SingerModel::axis_transition(limit / T, T)) < 1e-11);
 }
 
-TEST_CASE("alpha -> 0 with 2 alpha sigma^2 = q fixed gives the Wiener-process-acceleration CA model") {
+// alpha -> 0 with 2 alpha sigma^2 = q fixed gives the Wiener-process-acceleration CA model
+TEST_CASE("Singer with small alpha tends to the CA model") {
   const double T = 0.5, q = 3.0, alpha = 1e-7;
   SingerModel m;
   m.alpha = alpha;
@@ -111,7 +113,8 @@ TEST_CASE("alpha -> 0 with 2 alpha sigma^2 = q fixed gives the Wiener-process-ac
   CHECK(max_rel_entry(m.axis_transition(T), ConstantAcceleration::axis_transition(T)) < 10 * alpha * T);
 }
 
-TEST_CASE("alpha -> infinity with 2 sigma^2 / alpha = q fixed gives the CV model in position and velocity") {
+// alpha -> infinity with 2 sigma^2 / alpha = q fixed gives the CV model in position and velocity
+TEST_CASE("Singer with large alpha tends to the CV model") {
   const double T = 1.0, q = 2.0;
   for (double alpha : {1e3, 1e4}) {
     SingerModel m;

@@ -49,7 +49,8 @@ std::vector<std::pair<Vec3, Vec3>> geometries() {
 
 }  // namespace
 
-TEST_CASE("h(x) agrees with enu_to_spherical and range_rate of geometry.hpp") {
+// h(x) agrees with enu_to_spherical and range_rate of geometry.hpp
+TEST_CASE("h(x) agrees with enu_to_spherical and range_rate") {
   for (auto c : kConventions)
     for (const auto& [d, v] : geometries()) {
       const auto h = spherical_measurement<4>(d, v, c);
@@ -69,7 +70,8 @@ TEST_CASE("h(x) agrees with enu_to_spherical and range_rate of geometry.hpp") {
   CHECK(spherical_measurement<3>(east, Vec3::Zero(), AzimuthConvention::XCounterClockwise)(1) == Approx(0.0));
 }
 
-TEST_CASE("analytic Jacobian matches a numerical Jacobian, both conventions, with and without range rate") {
+// analytic Jacobian matches a numerical Jacobian, both conventions, with and without range rate
+TEST_CASE("analytic Jacobian matches a numerical Jacobian") {
   for (auto c : kConventions)
     for (const auto& [d, v] : geometries()) {
       SphericalJacobian<4> H4;
@@ -88,7 +90,8 @@ TEST_CASE("analytic Jacobian matches a numerical Jacobian, both conventions, wit
     }
 }
 
-TEST_CASE("paper 000 eq 3.24 as printed has a wrong rdot/z entry, and the corrected one matches") {
+// paper 000 eq 3.24 as printed has a wrong rdot/z entry, and the corrected one matches
+TEST_CASE("paper 000 eq 3.24 rdot/z entry is corrected") {
   const Vec3 d(3e3, 4e3, 2e3), v(-50, 80, 30);
   const double x = d.x(), y = d.y(), z = d.z(), R = d.norm();
   const double printed = (v.z() * (x * x + y * y) - x * (x * v.x() + y * v.y())) / (R * R * R);
@@ -98,7 +101,8 @@ TEST_CASE("paper 000 eq 3.24 as printed has a wrong rdot/z entry, and the correc
   CHECK(std::abs(N(3, 2) - printed) > 1e-3 * std::abs(N(3, 2)));
 }
 
-TEST_CASE("residual wraps the azimuth across +-pi and leaves elevation alone") {
+// residual wraps the azimuth across +-pi and leaves elevation alone
+TEST_CASE("residual wraps azimuth but not elevation") {
   SphericalVec<4> z, h;
   z << 1000, std::numbers::pi - 0.01, 0.3, -5;
   h << 990, -std::numbers::pi + 0.01, 0.2, -4;
@@ -114,7 +118,8 @@ TEST_CASE("residual wraps the azimuth across +-pi and leaves elevation alone") {
   CHECK(spherical_residual<4>(z, h)(2) == Approx(3.0));
 }
 
-TEST_CASE("at the zenith and at the sensor the Jacobian is finite and flagged") {
+// at the zenith and at the sensor the Jacobian is finite and flagged
+TEST_CASE("Jacobian is finite and flagged at the zenith") {
   for (auto c : kConventions) {
     SphericalJacobian<4> H;
     CHECK(spherical_measurement_jacobian<4>(Vec3(0, 0, 5000), Vec3(100, 0, 10), c, H) == SphericalSingularity::Zenith);

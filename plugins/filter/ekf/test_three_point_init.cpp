@@ -8,7 +8,8 @@
 
 using namespace trackflow;
 
-TEST_CASE("paper 000 P0: symmetric positive definite, equal to the printed matrix except its (3,1) typo") {
+// paper 000 P0: symmetric positive definite, equal to the printed matrix except its (3,1) typo
+TEST_CASE("paper 000 P0 is PD and matches the printed matrix") {
   const double s2 = 4.0, T = 0.025;
   const Eigen::Matrix3d P = cartesian_filter::paper000_axis_covariance(s2, T, T);
   Eigen::Matrix3d printed;
@@ -26,7 +27,9 @@ TEST_CASE("paper 000 P0: symmetric positive definite, equal to the printed matri
   CHECK(Eigen::LLT<Eigen::Matrix3d>(P).info() == Eigen::Success);
 }
 
-TEST_CASE("three-point differences recover a quadratic exactly in position and acceleration, and P0 matches sample covariance") {
+// three-point differences recover a quadratic exactly in position and acceleration, and P0 matches sample
+// covariance
+TEST_CASE("three-point init is exact and P0 matches samples") {
   const double T1 = 0.1, T2 = 0.15, p0 = 100, v0 = 30, a0 = -4;
   auto p = [&](double t) { return p0 + v0 * t + 0.5 * a0 * t * t; };
   const double t3 = T1 + T2;

@@ -25,7 +25,8 @@ Mat3 hessian(const Vec3& d, int row, AzimuthConvention c, double h) {
 
 }  // namespace
 
-TEST_CASE("curvature variances equal 1/2 tr(A P A P) with numerical Hessians near the zenith") {
+// curvature variances equal 1/2 tr(A P A P) with numerical Hessians near the zenith
+TEST_CASE("zenith curvature variances match numerical Hessians") {
   Eigen::Matrix2d Ph;
   Ph << 0.30, 0.05, 0.05, 0.02;  // anisotropic, correlated
   Mat3 P3 = Mat3::Zero();
@@ -43,7 +44,8 @@ TEST_CASE("curvature variances equal 1/2 tr(A P A P) with numerical Hessians nea
     }
 }
 
-TEST_CASE("far from the zenith the curvature terms are negligible against radar noise") {
+// far from the zenith the curvature terms are negligible against radar noise
+TEST_CASE("far from the zenith curvature terms are negligible") {
   Eigen::Matrix2d Ph = Eigen::Matrix2d::Identity() * 100.0;  // 10 m per axis at 10 km
   const auto v = ekf::angle_curvature_variance(Vec3(8e3, 6e3, 1e3), Ph, 1e-9);
   CHECK(v.azimuth < 1e-5 * 1e-6);  // below 1e-5 of a (1 mrad)^2 azimuth variance

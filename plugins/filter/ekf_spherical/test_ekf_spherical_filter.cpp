@@ -104,7 +104,8 @@ double deterministic_truth_anees(double T, double q, double sigma_p, double sigm
 
 }  // namespace
 
-TEST_CASE("long-range CV target, 200 runs: bounded ANEES and position error below the measurement error") {
+// long-range CV target, 200 runs: bounded ANEES and position error below the measurement error
+TEST_CASE("long-range CV target: bounded ANEES and error") {
   const int runs = 200, steps = 240;
   const double T = 0.5;
   const Vec3 sensor(1000, -500, 20);
@@ -159,7 +160,8 @@ TEST_CASE("long-range CV target, 200 runs: bounded ANEES and position error belo
   }
 }
 
-TEST_CASE("truth drawn from the filter's own model: ANEES and ANIS inside their chi-square bands") {
+// truth drawn from the filter's own model: ANEES and ANIS inside their chi-square bands
+TEST_CASE("own-model truth: ANEES and ANIS in their bands") {
   // The truth follows f with white-jerk noise sampled from Q at the true state, and is measured
   // through the linear H: only the EKF's linearisation separates the filter from the optimum, and
   // at 60 km with 1 mrad that is negligible, so the classical bands apply.
@@ -221,7 +223,8 @@ TEST_CASE("truth drawn from the filter's own model: ANEES and ANIS inside their 
   CHECK(std::abs(anis - 1.0) < 0.0097);
 }
 
-TEST_CASE("the same data in both azimuth conventions give the same ENU estimate; v_h changes sign") {
+// the same data in both azimuth conventions give the same ENU estimate; v_h changes sign
+TEST_CASE("both azimuth conventions give the same estimate") {
   Track cw, ccw;
   cw.start();
   ccw.start();
@@ -264,7 +267,8 @@ TEST_CASE("the same data in both azimuth conventions give the same ENU estimate;
   CHECK((last.enu.tail<3>() - v).norm() < 10.0);
 }
 
-TEST_CASE("azimuth crossing ±pi: no jump in the innovation, estimate stays on the target") {
+// azimuth crossing ±pi: no jump in the innovation, estimate stays on the target
+TEST_CASE("azimuth crossing pi gives no innovation jump") {
   // north_clockwise: south of the sensor moving west (bearing 180 deg); x_counterclockwise: west
   // of the sensor moving south (math angle 180 deg).
   struct Case {
@@ -299,7 +303,8 @@ TEST_CASE("azimuth crossing ±pi: no jump in the innovation, estimate stays on t
   }
 }
 
-TEST_CASE("passes near the zenith stay finite and recover; straight overhead the track holds") {
+// passes near the zenith stay finite and recover; straight overhead the track holds
+TEST_CASE("passes near and over the zenith stay finite") {
   // 250 m/s at 3 km altitude, 20 Hz, overhead (or `miss` metres to the side) at t = 32 s.
   for (double miss : {0.0, 3.0, 30.0}) {
     INFO("miss distance " << miss << " m");
@@ -363,7 +368,8 @@ TEST_CASE("an invalid measurement makes the filter coast") {
   CHECK(coast.covariance(es::kR, es::kR) > k.out.estimates[19].covariance(es::kR, es::kR));
 }
 
-TEST_CASE("range rate is used when present and improves the radial velocity") {
+// range rate is used when present and improves the radial velocity
+TEST_CASE("range rate improves the radial velocity") {
   double err_with = 0, err_without = 0;
   for (bool with_rate : {false, true}) {
     Track k;
@@ -388,7 +394,8 @@ TEST_CASE("range rate is used when present and improves the radial velocity") {
   CHECK(err_with < 0.5 * err_without);
 }
 
-TEST_CASE("noise handles: spherical R, three jerk intensities, and a change takes effect") {
+// noise handles: spherical R, three jerk intensities, and a change takes effect
+TEST_CASE("noise handles: spherical R and jerk intensities") {
   auto run = [](double qh_after) {
     Track k;
     k.start();
@@ -412,7 +419,8 @@ TEST_CASE("noise handles: spherical R, three jerk intensities, and a change take
   CHECK(run(100.0) > 2 * run(1.0));
 }
 
-TEST_CASE("explicit initialisation holds at the first measurement's time") {
+// explicit initialisation holds at the first measurement's time
+TEST_CASE("explicit initialisation holds at the first time") {
   Track k("{ init: explicit, initial_range: 20 km, initial_azimuth: 30 deg, initial_elevation: 5 deg, "
           "initial_velocity: [0, 100, 0], initial_sigma_range: 50 m, initial_sigma_angle: 5 mrad, "
           "initial_sigma_velocity: 50 m/s }");
@@ -435,7 +443,8 @@ TEST_CASE("explicit initialisation holds at the first measurement's time") {
   CHECK(err.dot(e.enu_covariance.topLeftCorner<3, 3>().ldlt().solve(err)) < 16.3);  // chi-square(3), 99.9 %
 }
 
-TEST_CASE("two-point start: first estimate uninitialised (zeros), second initialised") {
+// two-point start: first estimate uninitialised (zeros), second initialised
+TEST_CASE("two-point start initialises at the second") {
   Track k;
   k.start();
   Rng rng(6);

@@ -97,7 +97,8 @@ State exact_state(const std::function<Vec3(double)>& d, double t, AzimuthConvent
 
 }  // namespace
 
-TEST_CASE("analytic F equals a central-difference Jacobian of f, including large T and high elevation") {
+// analytic F equals a central-difference Jacobian of f, including large T and high elevation
+TEST_CASE("analytic F equals a numerical Jacobian of f") {
   const Guard g;
   struct Case {
     State x;
@@ -120,7 +121,7 @@ TEST_CASE("analytic F equals a central-difference Jacobian of f, including large
   }
 }
 
-TEST_CASE("inside the guard F is the Jacobian of the guarded f") {
+TEST_CASE("inside the guard F is the guarded f Jacobian") {
   Guard g;
   g.min_range = 1.0;
   g.max_elevation = 85 * kDeg;
@@ -134,7 +135,8 @@ TEST_CASE("inside the guard F is the Jacobian of the guarded f") {
   }
 }
 
-TEST_CASE("the entries paper 000 prints wrongly in eq 3.60 differ from the numerical Jacobian; ours agree") {
+// the entries paper 000 prints wrongly in eq 3.60 differ from the numerical Jacobian; ours agree
+TEST_CASE("paper 000 eq 3.60 misprints are corrected") {
   const Guard g;
   const State x = make_state(30e3, -150, 2, 0.5, 220, -3, 0.6, 90, 1.5);
   const double T = 2.0, R = x(kR), vr = x(kVr), ar = x(kAr), vh = x(kVh), ah = x(kAh), ph = x(kPhi), vv = x(kVv),
@@ -168,7 +170,8 @@ TEST_CASE("the entries paper 000 prints wrongly in eq 3.60 differ from the numer
   CHECK(F(kPhi, kAv) == Approx(T * T / (2 * R)).epsilon(1e-12));
 }
 
-TEST_CASE("one step of f on a constant-velocity Cartesian target: position error O(T^3), velocity O(T^2)") {
+// one step of f on a constant-velocity Cartesian target: position error O(T^3), velocity O(T^2)
+TEST_CASE("one step of f on a CV target: error orders") {
   const Guard g;
   struct Geometry {
     Vec3 d0, v;
@@ -205,7 +208,8 @@ TEST_CASE("one step of f on a constant-velocity Cartesian target: position error
   }
 }
 
-TEST_CASE("ENU map: Jacobian equals central differences; velocity equals the derivative of position") {
+// ENU map: Jacobian equals central differences; velocity equals the derivative of position
+TEST_CASE("ENU map Jacobian and velocity are consistent") {
   for (auto conv : {AzimuthConvention::NorthClockwise, AzimuthConvention::XCounterClockwise}) {
     for (const State& x : {make_state(30e3, -150, 2, 0.5, 220, -3, 0.6, 90, 1.5),
                            make_state(900, 20, 0, -2.8, -60, 0, -0.4, 10, 0),
@@ -237,7 +241,8 @@ TEST_CASE("ENU map: Jacobian equals central differences; velocity equals the der
   }
 }
 
-TEST_CASE("v_h points toward increasing azimuth in both conventions") {
+// v_h points toward increasing azimuth in both conventions
+TEST_CASE("v_h points toward increasing azimuth") {
   // Due north of the sensor, moving east: the compass bearing increases, the math angle decreases.
   const Vec3 d0(0, 10e3, 0), v(100, 0, 0);
   auto d = [&](double s) -> Vec3 { return d0 + v * s; };
@@ -249,7 +254,8 @@ TEST_CASE("v_h points toward increasing azimuth in both conventions") {
   CHECK(to_enu(ccw, AzimuthConvention::XCounterClockwise).tail<3>().isApprox(v, 1e-6));
 }
 
-TEST_CASE("process noise: paper's Q1 per channel with the angle rows scaled by 1/R_h and 1/R") {
+// process noise: paper's Q1 per channel with the angle rows scaled by 1/R_h and 1/R
+TEST_CASE("process noise is the paper's scaled Q1") {
   const Guard g;
   const State x = make_state(20e3, 0, 0, 0.3, 0, 0, 0.5, 0, 0);
   const double T = 0.5, q[3] = {2.0, 3.0, 5.0};
@@ -270,7 +276,8 @@ TEST_CASE("process noise: paper's Q1 per channel with the angle rows scaled by 1
   CHECK(Eigen::SelfAdjointEigenSolver<Matrix>(Q).eigenvalues().minCoeff() > -1e-18);
 }
 
-TEST_CASE("two-point initial covariance matches the Monte Carlo spread of the initial state") {
+// two-point initial covariance matches the Monte Carlo spread of the initial state
+TEST_CASE("two-point P0 matches the Monte Carlo spread") {
   const double T = 0.5;
   const Vec3 d1(30e3, 40e3, 10e3), v(-200, 150, 40);
   const Vec3 d2 = d1 + v * T;
@@ -325,7 +332,8 @@ TEST_CASE("two-point initial covariance matches the Monte Carlo spread of the in
   }
 }
 
-TEST_CASE("folding a state over the zenith changes its coordinates, not the point, velocity or ENU covariance") {
+// folding a state over the zenith changes its coordinates, not the point, velocity or ENU covariance
+TEST_CASE("folding over the zenith keeps the ENU state") {
   Rng rng(21);
   for (double phi : {1.7, 2.5, -1.65, -3.0}) {
     State x = make_state(12e3, -40, 1, 2.9, 130, -2, phi, 75, 0.5);

@@ -113,7 +113,8 @@ Eigen::Matrix<double, 9, 3> applied_gain(const std::string& type, const std::str
 
 }  // namespace
 
-TEST_CASE("gain-transform gain vs filter.ekf's gain along paper 002's circle (same measurements)") {
+// gain-transform gain vs filter.ekf's gain along paper 002's circle (same measurements)
+TEST_CASE("gain vs filter.ekf gain on the paper 002 circle") {
   const int steps = 1700;
   const auto ms = circle_measurements(steps, 7);
   double worst_after_1s = 0.0;
@@ -136,7 +137,8 @@ TEST_CASE("gain-transform gain vs filter.ekf's gain along paper 002's circle (sa
   CHECK(worst_after_1s < 0.05);
 }
 
-TEST_CASE("same tracking accuracy as filter.ekf on the circle: position RMSE within 2 %") {
+// same tracking accuracy as filter.ekf on the circle: position RMSE within 2 %
+TEST_CASE("circle accuracy within 2 percent of filter.ekf") {
   const int runs = 20, steps = 800;
   double sq_gt = 0, sq_ekf = 0;
   int n = 0;
@@ -160,7 +162,8 @@ TEST_CASE("same tracking accuracy as filter.ekf on the circle: position RMSE wit
   CHECK(rmse_gt < 8.0);  // measurement cross-range error alone is 4.5 m, range 15 m
 }
 
-TEST_CASE("consistent on a Singer target: ANEES (9 states) inside the 99 % chi-square band over 200 runs") {
+// consistent on a Singer target: ANEES (9 states) inside the 99 % chi-square band over 200 runs
+TEST_CASE("Singer target: ANEES inside the 99 percent band") {
   // Truth drawn from the filter's own model (alpha 1/s, sigma_m 20 m/s2, exact discretisation),
   // 3 to 4 km from the radar, paper 002's radar (40 Hz, 15 m, 3 mrad). NEES at the last step
   // (10 s): independent across runs, so chi2(9M)/(9M) for an exact filter. The gain transform
@@ -202,7 +205,8 @@ TEST_CASE("consistent on a Singer target: ANEES (9 states) inside the 99 % chi-s
   CHECK(std::abs(anees_gt - anees_ekf) < 0.05);
 }
 
-TEST_CASE("paper 002's manoeuvre (150 -> 300 m/s, 60 deg climb): symmetric PSD covariance, recovery") {
+// paper 002's manoeuvre (150 -> 300 m/s, 60 deg climb): symmetric PSD covariance, recovery
+TEST_CASE("paper 002 manoeuvre: PSD covariance and recovery") {
   Run run("filter.gain_transform", kGt);
   Rng rng(13);
   const Vec3 p0(-500, 1500, 100), v0(150, 0, 0);
@@ -237,7 +241,8 @@ TEST_CASE("paper 002's manoeuvre (150 -> 300 m/s, 60 deg climb): symmetric PSD c
   CHECK(final_nees < 30.0);  // chi2(6) exceeds 22.5 with probability 1e-3
 }
 
-TEST_CASE("azimuth wrap: a target crossing the branch cut gives no 2 pi innovation (both conventions)") {
+// azimuth wrap: a target crossing the branch cut gives no 2 pi innovation (both conventions)
+TEST_CASE("crossing the azimuth cut gives no 2 pi jump") {
   for (auto c : {AzimuthConvention::NorthClockwise, AzimuthConvention::XCounterClockwise}) {
     Run run("filter.gain_transform", kGt);
     Rng rng(9);
@@ -263,7 +268,8 @@ TEST_CASE("azimuth wrap: a target crossing the branch cut gives no 2 pi innovati
   }
 }
 
-TEST_CASE("a pass straight over the radar stays finite with a symmetric PSD covariance") {
+// a pass straight over the radar stays finite with a symmetric PSD covariance
+TEST_CASE("a pass straight overhead stays finite and PSD") {
   for (double offset : {0.0, 0.3, 30.0}) {
     INFO("horizontal miss distance " << offset << " m");
     Run run("filter.gain_transform", kGt);
@@ -286,7 +292,8 @@ TEST_CASE("a pass straight over the radar stays finite with a symmetric PSD cova
   }
 }
 
-TEST_CASE("an invalid measurement makes the filter coast: prediction only, covariance grows") {
+// an invalid measurement makes the filter coast: prediction only, covariance grows
+TEST_CASE("an invalid measurement makes the filter coast") {
   Run run("filter.gain_transform", kGt);
   for (int k = 0; k < 40; ++k) run.feed(radar(k * kT, circle_position(k * kT), Vec3::Zero(), nullptr));
   Measurement bad = radar(40 * kT, Vec3(1e9, 1e9, 1e9), Vec3::Zero(), nullptr);
@@ -314,7 +321,8 @@ TEST_CASE("an invalid measurement makes the filter coast: prediction only, covar
   CHECK(symmetric_psd(back.covariance));
 }
 
-TEST_CASE("the first two measurements initialise, older ones are skipped, a range rate is ignored") {
+// the first two measurements initialise, older ones are skipped, a range rate is ignored
+TEST_CASE("two-point init and old measurements skipped") {
   Run run("filter.gain_transform", kGt), with_rr("filter.gain_transform", kGt);
   Rng rng(2);
   std::vector<Measurement> ms;
@@ -353,7 +361,8 @@ TEST_CASE("the first two measurements initialise, older ones are skipped, a rang
   CHECK(run.diag.skips[0].node == "f");
 }
 
-TEST_CASE("noise handles: spherical R and per-axis sigma_m that the prediction follows") {
+// noise handles: spherical R and per-axis sigma_m that the prediction follows
+TEST_CASE("noise handles: spherical R and sigma_m") {
   Run a("filter.gain_transform", kGt), b("filter.gain_transform", kGt);
   auto* fb = dynamic_cast<Filter*>(b.filter.get());
   REQUIRE(fb);

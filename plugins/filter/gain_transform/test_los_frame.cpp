@@ -93,7 +93,8 @@ const Vec3 kPositions[] = {{1500, 0, 150},      {-900, 1200, 150}, {300, -2500, 
 
 }  // namespace
 
-TEST_CASE("LOS frame: D orthonormal, h = enu_to_spherical, F(X) = D Lambda and G(X) = Lambda^-1 D' numerically") {
+// LOS frame: D orthonormal, h = enu_to_spherical, F(X) = D Lambda and G(X) = Lambda^-1 D' numerically
+TEST_CASE("LOS frame D F(X) and G(X) match numerics") {
   for (auto c : {AzimuthConvention::NorthClockwise, AzimuthConvention::XCounterClockwise})
     for (const Vec3& d : kPositions) {
       INFO("convention " << int(c) << ", d = " << d.transpose());
@@ -123,7 +124,8 @@ TEST_CASE("LOS frame: D orthonormal, h = enu_to_spherical, F(X) = D Lambda and G
     }
 }
 
-TEST_CASE("Singer prediction of one block equals F B F' + sigma^2 Q from SingerModel") {
+// Singer prediction of one block equals F B F' + sigma^2 Q from SingerModel
+TEST_CASE("Singer block prediction equals SingerModel") {
   Rng rng(3);
   for (double alpha : {0.01, 1.0, 30.0})
     for (double T : {0.025, 0.5}) {
@@ -150,7 +152,8 @@ TEST_CASE("Singer prediction of one block equals F B F' + sigma^2 Q from SingerM
     }
 }
 
-TEST_CASE("reframe keeps the diagonal blocks of the rotated block-diagonal covariance, ENU covariance = T P̄ T'") {
+// reframe keeps the diagonal blocks of the rotated block-diagonal covariance, ENU covariance = T P̄ T'
+TEST_CASE("reframe keeps the rotated diagonal blocks") {
   Rng rng(5);
   const LosFrame<double> f0 = frame_of(Vec3(1500, 0, 150), AzimuthConvention::NorthClockwise);
   for (const Vec3& d : {Vec3(1499.9, 15, 150.5), Vec3(-300, 2000, 800), Vec3(0.5, 0.5, 2000)}) {
@@ -175,7 +178,8 @@ TEST_CASE("reframe keeps the diagonal blocks of the rotated block-diagonal covar
   }
 }
 
-TEST_CASE("decoupled gain = full Kalman gain when P̄ is block-diagonal in the LOS frame (eq 35 is exact then)") {
+// decoupled gain = full Kalman gain when P̄ is block-diagonal in the LOS frame (eq 35 is exact then)
+TEST_CASE("decoupled gain exact for block-diagonal P") {
   Rng rng(11);
   for (auto c : {AzimuthConvention::NorthClockwise, AzimuthConvention::XCounterClockwise})
     for (const Vec3& d : kPositions) {
@@ -220,7 +224,8 @@ TEST_CASE("decoupled gain = full Kalman gain when P̄ is block-diagonal in the L
     }
 }
 
-TEST_CASE("with the paper's G0 (no cos el) the azimuth column of the gain is off by 1/cos(el)") {
+// with the paper's G0 (no cos el) the azimuth column of the gain is off by 1/cos(el)
+TEST_CASE("paper G0 azimuth gain is off by 1/cos(el)") {
   // At the circle scenario's 5.7 deg the difference is 0.5 %; after the 60 deg climb, a factor ~2.
   for (double el_deg : {5.7, 60.0}) {
     const double el = el_deg * std::numbers::pi / 180.0, r = 2000.0;

@@ -6,7 +6,8 @@
 using namespace trackflow;
 using namespace trackflow::gain_transform;
 
-TEST_CASE("the counting scalar counts what it should and computes what double computes") {
+// the counting scalar counts what it should and computes what double computes
+TEST_CASE("counting scalar counts and computes like double") {
   const OperationCount c = count_operations([] {
     const Counted a = 3.0, b = 4.0;
     const Counted r = sqrt(a * a + b * b) / (a - b);
@@ -31,7 +32,8 @@ TEST_CASE("the counting scalar counts what it should and computes what double co
   CHECK(gemm.mul == 9 * 9 * 3 + 9 * 3 + 2);
 }
 
-TEST_CASE("gain-transform step: the counts stated in gain_transform_core.hpp") {
+// gain-transform step: the counts stated in gain_transform_core.hpp
+TEST_CASE("gain-transform step has the stated counts") {
   const StepCounts c = count_gain_transform_step();
   CHECK(c.covariance_prediction.mul == 1 + 3 * 22);  // sigma^2, then 16 + 6 per LOS axis
   CHECK(c.linearisation.mul == 8 + 14);              // frame (los_frame.hpp), measurement_variances
@@ -45,7 +47,8 @@ TEST_CASE("gain-transform step: the counts stated in gain_transform_core.hpp") {
   CHECK(c.gain_computation().mul == 67 + 22 + 150);
 }
 
-TEST_CASE("filter.ekf step (replica of its arithmetic): dense fixed-size products") {
+// filter.ekf step (replica of its arithmetic): dense fixed-size products
+TEST_CASE("filter.ekf step replica: dense products") {
   const StepCounts c = count_filter_ekf_step();
   CHECK(c.covariance_prediction.mul == 9 * 54 + 3 * 10 + 81);
   CHECK(c.linearisation.mul == 5 + 28);  // Jacobian, angle curvature
@@ -61,7 +64,8 @@ TEST_CASE("filter.ekf step (replica of its arithmetic): dense fixed-size product
   CHECK(g.gain_computation().mul < 0.1 * c.gain_computation().mul);
 }
 
-TEST_CASE("lean EKF step: structured prediction and H-sparse symmetric update") {
+// lean EKF step: structured prediction and H-sparse symmetric update
+TEST_CASE("lean EKF step: structured and sparse") {
   const StepCounts c = count_lean_ekf_step();
   CHECK(c.covariance_prediction.mul == 1 + 138);  // sigma^2, then lean_predict_covariance
   CHECK(c.linearisation.mul == 8);

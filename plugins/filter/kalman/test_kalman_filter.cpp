@@ -47,7 +47,8 @@ struct ReferenceKf {
 
 }  // namespace
 
-TEST_CASE("CV filter agrees with a textbook Kalman filter step by step") {
+// CV filter agrees with a textbook Kalman filter step by step
+TEST_CASE("CV filter agrees with a textbook Kalman filter") {
   auto kf = test::make("filter.kalman", "{ motion: constant_velocity, q: 2 m2/s3 }");
   test::Collector out;
   out.attach_to(*kf);
@@ -92,7 +93,8 @@ TEST_CASE("CV filter agrees with a textbook Kalman filter step by step") {
   CHECK(last.enu(3) == last.state(1));  // vx sits at index 1 of the interleaved state
 }
 
-TEST_CASE("NEES of the CV filter on a CV target is consistent over 300 runs") {
+// NEES of the CV filter on a CV target is consistent over 300 runs
+TEST_CASE("CV filter NEES is consistent over 300 runs") {
   const int runs = 300, steps = 40;
   const double sigma = 10.0, T = 0.5;
   double nees_sum = 0;
@@ -133,7 +135,8 @@ TEST_CASE("NEES of the CV filter on a CV target is consistent over 300 runs") {
   CHECK(anees < 1.08);
 }
 
-TEST_CASE("an invalid measurement makes the filter coast: prediction only, covariance grows") {
+// an invalid measurement makes the filter coast: prediction only, covariance grows
+TEST_CASE("an invalid measurement makes the filter coast") {
   auto kf = test::make("filter.kalman");
   test::Collector out;
   out.attach_to(*kf);
@@ -151,7 +154,8 @@ TEST_CASE("an invalid measurement makes the filter coast: prediction only, covar
   CHECK(coast.enu_covariance(0, 0) > out.estimates[4].enu_covariance(0, 0));
 }
 
-TEST_CASE("constant-acceleration model tracks an accelerating target without lag") {
+// constant-acceleration model tracks an accelerating target without lag
+TEST_CASE("CA model tracks an accelerating target without lag") {
   auto kf = test::make("filter.kalman", "{ motion: constant_acceleration, q_jerk: 0.001 m2/s5 }");
   test::Collector out;
   out.attach_to(*kf);
@@ -179,7 +183,8 @@ TEST_CASE("wrong inputs and parameters are clear errors") {
   CHECK_THROWS_WITH(test::make("filter.kalman", "{ q: 1 m2/s3, sigma_accel: 1 m/s2 }"), Catch::Contains("not both"));
 }
 
-TEST_CASE("explicit initialisation holds at the first measurement's time (no infinite first step)") {
+// explicit initialisation holds at the first measurement's time (no infinite first step)
+TEST_CASE("explicit initialisation holds at the first time") {
   auto kf = test::make("filter.kalman", "{ init: explicit, initial_position: [0, 0, 0], initial_velocity: [10, 0, 0], "
                                         "initial_sigma_position: 5 m, initial_sigma_velocity: 2 m/s }");
   test::Collector out;
@@ -197,7 +202,8 @@ TEST_CASE("explicit initialisation holds at the first measurement's time (no inf
   CHECK(out.estimates[1].enu(0) == Approx(11).margin(2));
 }
 
-TEST_CASE("estimates published before initialisation carry defined (zero) state") {
+// estimates published before initialisation carry defined (zero) state
+TEST_CASE("estimates before initialisation carry zero state") {
   auto kf = test::make("filter.kalman");
   test::Collector out;
   out.attach_to(*kf);
@@ -218,7 +224,8 @@ TEST_CASE("estimates published before initialisation carry defined (zero) state"
   CHECK(out.estimates.back().innovation.size() == 0);
 }
 
-TEST_CASE("a process-noise change through noise() takes effect at the next step even at a fixed T") {
+// a process-noise change through noise() takes effect at the next step even at a fixed T
+TEST_CASE("a process-noise change takes effect at next step") {
   auto run = [](double q_after) {
     auto c = test::make("filter.kalman", "{ q: 1 m2/s3 }");
     auto& f = dynamic_cast<Filter&>(*c);
@@ -234,7 +241,7 @@ TEST_CASE("a process-noise change through noise() takes effect at the next step 
   CHECK(run(100.0) > 2 * run(1.0));
 }
 
-TEST_CASE("annotations an adapter sets are carried by the next published estimates") {
+TEST_CASE("adapter annotations ride on the next estimates") {
   struct Annotator : Adapter {
     std::vector<std::string> annotation_names() const override { return {"a", "b", "c"}; }
     void before_update(const Measurement& m, Filter& f) override {
@@ -265,7 +272,7 @@ TEST_CASE("annotations an adapter sets are carried by the next published estimat
   CHECK(std::isnan(out.estimates.back().annotations[0]));
 }
 
-TEST_CASE("a process noise retuned by an adapter is restored by the engine before the next run") {
+TEST_CASE("engine restores retuned process noise before next run") {
   auto c = test::make("filter.kalman", "{ q: 1 m2/s3 }");
   auto& f = dynamic_cast<Filter&>(*c);
   f.save_configured_noise();  // the engine, once the instance is built

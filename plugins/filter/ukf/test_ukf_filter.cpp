@@ -108,7 +108,8 @@ bool healthy(const StateCov& P) {
 
 }  // namespace
 
-TEST_CASE("UKF agrees step by step with a textbook scaled UKF (CV, CA, both conventions, several alpha/beta/kappa)") {
+// UKF agrees step by step with a textbook scaled UKF (CV, CA, both conventions, several alpha/beta/kappa)
+TEST_CASE("UKF agrees step by step with a textbook scaled UKF") {
   struct Case {
     const char* motion;
     int order;
@@ -170,7 +171,8 @@ TEST_CASE("UKF agrees step by step with a textbook scaled UKF (CV, CA, both conv
   }
 }
 
-TEST_CASE("with small noise the UKF equals the EKF closely (both linearise the same h)") {
+// with small noise the UKF equals the EKF closely (both linearise the same h)
+TEST_CASE("with small noise the UKF closely equals the EKF") {
   // Small R and a small initial P near the truth: the sigma points stay where h is linear to
   // well below the noise. (From a two-point start the velocity sigma, ~140 m/s here, makes the
   // bilinear term of the range rate, dp dv / r, visible: the UKF then rightly differs.)
@@ -211,7 +213,8 @@ TEST_CASE("with small noise the UKF equals the EKF closely (both linearise the s
   }
 }
 
-TEST_CASE("strongly nonlinear (large angle noise at short range): the UKF's predicted measurement beats the EKF's") {
+// strongly nonlinear (large angle noise at short range): the UKF's predicted measurement beats the EKF's
+TEST_CASE("strongly nonlinear: UKF prediction beats the EKF") {
   // The predicted measurement of each filter is z - innovation at the first update of an explicit
   // initial state (no prediction in between). Reference: E[h(x)] and cov[h(x)], x ~ N(x0, P0),
   // by sampling.
@@ -274,7 +277,8 @@ TEST_CASE("strongly nonlinear (large angle noise at short range): the UKF's pred
   CHECK(du < de);
 }
 
-TEST_CASE("UKF is consistent over 200 Monte Carlo runs of a CV target (NEES at the last step, NIS over all steps)") {
+// UKF is consistent over 200 Monte Carlo runs of a CV target (NEES at the last step, NIS over all steps)
+TEST_CASE("UKF is consistent over 200 Monte Carlo runs") {
   const int runs = 200, steps = 40;
   const double T = 0.5, q = 1.0;
   const Eigen::Matrix2d Qa = ConstantVelocity::axis_noise_continuous(T, q);
@@ -312,7 +316,8 @@ TEST_CASE("UKF is consistent over 200 Monte Carlo runs of a CV target (NEES at t
   }
 }
 
-TEST_CASE("CA UKF tracks a constantly accelerating target, initialised by two_point or paper000") {
+// CA UKF tracks a constantly accelerating target, initialised by two_point or paper000
+TEST_CASE("CA UKF tracks an accelerating target") {
   for (const char* init : {"two_point", "paper000"}) {
     INFO("init " << init);
     Ukf run(std::string("{ motion: constant_acceleration, q_jerk: 0.01 m2/s5, init: ") + init + " }");
@@ -342,7 +347,8 @@ TEST_CASE("CA UKF tracks a constantly accelerating target, initialised by two_po
   }
 }
 
-TEST_CASE("sigma points straddling the azimuth cut (due south / due west) give no 2 pi residuals") {
+// sigma points straddling the azimuth cut (due south / due west) give no 2 pi residuals
+TEST_CASE("sigma points across the azimuth cut: no 2 pi") {
   for (auto c : {AzimuthConvention::NorthClockwise, AzimuthConvention::XCounterClockwise}) {
     const bool nc = c == AzimuthConvention::NorthClockwise;
     INFO("convention " << int(c));
@@ -390,7 +396,8 @@ TEST_CASE("sigma points straddling the azimuth cut (due south / due west) give n
   }
 }
 
-TEST_CASE("long runs keep the covariance symmetric and positive definite (40 Hz, 0.3 m / 50 urad, 20000 steps)") {
+// long runs keep the covariance symmetric and positive definite (40 Hz, 0.3 m / 50 urad, 20000 steps)
+TEST_CASE("long runs keep the covariance symmetric PD") {
   // Precise measurements at a high rate drive P towards ill-conditioning (position variance
   // ~0.01 m2 against an acceleration variance orders above): where P - K S K' loses definiteness.
   for (const char* extra : {"", ", alpha: 0.001, kappa: 0"}) {
@@ -422,7 +429,8 @@ TEST_CASE("long runs keep the covariance symmetric and positive definite (40 Hz,
   }
 }
 
-TEST_CASE("numerical repairs: a near-singular P is jittered, a negative centre weight contained, both reported once") {
+// numerical repairs: a near-singular P is jittered, a negative centre weight contained, both reported once
+TEST_CASE("numerical repairs are made and reported once") {
   SECTION("P singular to rounding: q = 0 and a position sigma of 1 um against 10 km/s") {
     Ukf run("{ q: 0 m2/s3, " + explicit_init(Vec3(5e3, 5e3, 1e3), Vec3(100, 0, 0), 1e-6, 1e4) + " }");
     for (int k = 0; k < 5; ++k) {
@@ -456,7 +464,8 @@ TEST_CASE("numerical repairs: a near-singular P is jittered, a negative centre w
   }
 }
 
-TEST_CASE("passes straight over the radar and through the sensor stay finite") {
+// passes straight over the radar and through the sensor stay finite
+TEST_CASE("passes overhead and through the sensor stay finite") {
   for (double offset : {0.0, 0.3, 3.0, 30.0}) {
     INFO("horizontal miss distance " << offset << " m");
     Ukf run("{ motion: constant_acceleration, q_jerk: 1 m2/s5 }");
@@ -497,7 +506,8 @@ TEST_CASE("passes straight over the radar and through the sensor stay finite") {
   }
 }
 
-TEST_CASE("UKF coasts on invalid measurements, skips old ones, exposes its noise") {
+// UKF coasts on invalid measurements, skips old ones, exposes its noise
+TEST_CASE("UKF coasts and skips old data and exposes noise") {
   Ukf run("{ q: 1 m2/s3 }");
   const Vec3 v(100, 0, 0);
   for (int k = 0; k < 6; ++k)

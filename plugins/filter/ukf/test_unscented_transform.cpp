@@ -67,7 +67,8 @@ SampleMoments<M> sample_moments(const Vec6d& mean, const Mat6d& P, int n, double
 
 }  // namespace
 
-TEST_CASE("scaled weights: mean weights sum to one, the defaults put the points at sqrt(3) sigma with W0c >= 0") {
+// scaled weights: mean weights sum to one, the defaults put the points at sqrt(3) sigma with W0c >= 0
+TEST_CASE("scaled weights sum to one with default spread") {
   for (int n : {6, 9})
     for (double alpha : {1e-3, 0.5, 1.0})
       for (double kappa : {0.0, 3.0 - n, 1.0}) {
@@ -85,7 +86,8 @@ TEST_CASE("scaled weights: mean weights sum to one, the defaults put the points 
   CHECK(ukf::ScaledWeights::make(6, 1e-3, 2.0, 0.0).cov0 < -1e5);
 }
 
-TEST_CASE("for a linear map the transform is exact: mean A x + b, H = A, nothing left over") {
+// for a linear map the transform is exact: mean A x + b, H = A, nothing left over
+TEST_CASE("the transform is exact for a linear map") {
   Rng rng(4);
   Eigen::Matrix<double, 3, 6> A;
   for (int i = 0; i < 3; ++i)
@@ -106,7 +108,8 @@ TEST_CASE("for a linear map the transform is exact: mean A x + b, H = A, nothing
     }
 }
 
-TEST_CASE("H P H' + extra and P H' are the textbook unscented P_zz and P_xz") {
+// H P H' + extra and P H' are the textbook unscented P_zz and P_xz
+TEST_CASE("H P H' + extra and P H' are textbook P_zz P_xz") {
   Rng rng(8);
   Vec6d x;
   x << 900, -40, 700, 25, 300, 5;  // about 1.2 km from the sensor
@@ -140,7 +143,8 @@ TEST_CASE("H P H' + extra and P H' are the textbook unscented P_zz and P_xz") {
   }
 }
 
-TEST_CASE("as P shrinks the statistical linearisation tends to the analytic Jacobian") {
+// as P shrinks the statistical linearisation tends to the analytic Jacobian
+TEST_CASE("small P: statistical H tends to the Jacobian") {
   Vec6d x;
   x << 4e3, -100, 3e3, 50, 1e3, 10;
   Rng rng(2);
@@ -168,7 +172,8 @@ TEST_CASE("as P shrinks the statistical linearisation tends to the analytic Jaco
   CHECK(prev < 1e-7);
 }
 
-TEST_CASE("strongly nonlinear (300 m range, 100 m position sigma): the UT mean matches Monte Carlo, h(mean) does not") {
+// strongly nonlinear (300 m range, 100 m position sigma): the UT mean matches Monte Carlo, h(mean) does not
+TEST_CASE("strongly nonlinear: UT mean matches Monte Carlo") {
   Vec6d x;
   x << 200, 10, 200, -5, 100, 0;  // 300 m from the sensor
   const Mat6d P = (Vec6d() << 1e4, 1, 1e4, 1, 1e4, 1).finished().asDiagonal();
@@ -192,7 +197,8 @@ TEST_CASE("strongly nonlinear (300 m range, 100 m position sigma): the UT mean m
   }
 }
 
-TEST_CASE("sigma points straddling the azimuth cut: mean at +-pi, covariance as on any other bearing") {
+// sigma points straddling the azimuth cut: mean at +-pi, covariance as on any other bearing
+TEST_CASE("sigma points across the azimuth cut") {
   for (auto c : {AzimuthConvention::NorthClockwise, AzimuthConvention::XCounterClockwise}) {
     const bool nc = c == AzimuthConvention::NorthClockwise;
     Vec6d x = Vec6d::Zero();  // due south (north_clockwise) or due west (x_counterclockwise), 2 km
@@ -227,7 +233,8 @@ TEST_CASE("sigma points straddling the azimuth cut: mean at +-pi, covariance as 
   }
 }
 
-TEST_CASE("guarded Cholesky: untouched when positive definite, jitter for a singular P, refusal when indefinite") {
+// guarded Cholesky: untouched when positive definite, jitter for a singular P, refusal when indefinite
+TEST_CASE("guarded Cholesky: PD singular and indefinite P") {
   Rng rng(12);
   Mat6d P = random_covariance(rng, (Vec6d() << 10, 1, 10, 1, 10, 1).finished());
   const Mat6d P0 = P;

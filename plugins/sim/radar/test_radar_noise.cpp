@@ -75,7 +75,8 @@ double db_to_linear(double db) { return std::pow(10.0, db / 10.0); }
 
 }  // namespace
 
-TEST_CASE("the draws follow the documented order: [SNR jitter,] range, azimuth, elevation, range rate") {
+// the draws follow the documented order: [SNR jitter,] range, azimuth, elevation, range rate
+TEST_CASE("the draws follow the documented order") {
   std::vector<Truth> truths;
   for (int k = 0; k < 30; ++k) truths.push_back(truth_at(0.1 * k, Vec3(4000 + 50 * k, -2500, 700), Vec3(500, 20, -3)));
   SECTION("constant model: four normals per look, nothing else") {
@@ -116,7 +117,8 @@ TEST_CASE("the draws follow the documented order: [SNR jitter,] range, azimuth, 
   }
 }
 
-TEST_CASE("snr model: sigma from paper 001 eq 6-8 over an R^-4 or R^-2 link budget") {
+// snr model: sigma from paper 001 eq 6-8 over an R^-4 or R^-2 link budget
+TEST_CASE("snr model: sigma from paper 001 eq 6-8") {
   const double dr = 15.0, bw = 2 * std::numbers::pi / 180, km = 1.6;
   for (const char* law : {"radar_r4", "beacon_r2"}) {
     INFO(law);
@@ -155,7 +157,8 @@ TEST_CASE("snr model: sigma from paper 001 eq 6-8 over an R^-4 or R^-2 link budg
   }
 }
 
-TEST_CASE("snr jitter: SNR varies per measurement with the given dB sigma, and the covariance follows it") {
+// snr jitter: SNR varies per measurement with the given dB sigma, and the covariance follows it
+TEST_CASE("snr jitter varies SNR and the covariance follows") {
   const int n = 20000;
   const auto truths = still_target(n, 30e3);
   const auto ms = measure("noise_model: snr\nsnr_jitter: 3 dB\nrange_resolution: 20 m", truths, 11);
@@ -175,7 +178,8 @@ TEST_CASE("snr jitter: SNR varies per measurement with the given dB sigma, and t
   CHECK(e.sd == Approx(1.0).epsilon(sd_tolerance(n)));
 }
 
-TEST_CASE("table4 model: paper 000 Table 4 at its rows, held outside, log-log in between") {
+// table4 model: paper 000 Table 4 at its rows, held outside, log-log in between
+TEST_CASE("table4 model: paper 000 Table 4 interpolation") {
   struct Row {
     double range, snr, sr, sa;
   };
@@ -206,7 +210,8 @@ TEST_CASE("table4 model: paper 000 Table 4 at its rows, held outside, log-log in
   for (int i = 0; i < 4; ++i) CHECK(ms[i].snr_db == Approx(45 - 20 * std::log10(rows[i].range / 158.48e3)).margin(0.03));
 }
 
-TEST_CASE("noise presets and noise_factor multiply every sigma, in every model") {
+// noise presets and noise_factor multiply every sigma, in every model
+TEST_CASE("noise presets and noise_factor scale every sigma") {
   const auto truths = still_target(20000, 8e3);
   const std::string base = "range_rate: true\nsigma_range: 4 m\nsigma_azimuth: 1 mrad\nsigma_elevation: 2 mrad\nsigma_range_rate: 0.3 m/s\n";
   struct Case {
@@ -252,7 +257,8 @@ TEST_CASE("noise presets and noise_factor multiply every sigma, in every model")
   }
 }
 
-TEST_CASE("shot noise: bursts of shot_length samples every shot_period multiply sigma, the covariance stays nominal") {
+// shot noise: bursts of shot_length samples every shot_period multiply sigma, the covariance stays nominal
+TEST_CASE("shot noise bursts scale sigma but not covariance") {
   const int n = 400;
   std::vector<Truth> truths;
   for (int k = 0; k < n; ++k) truths.push_back(truth_at(0.025 * k, Vec3(3000 + 10 * k, 9000, 1200), Vec3(400, 0, 0)));
@@ -308,7 +314,8 @@ TEST_CASE("shot noise: bursts of shot_length samples every shot_period multiply 
   }
 }
 
-TEST_CASE("mode schedule: mode and sigma overrides per window, default_mode outside") {
+// mode schedule: mode and sigma overrides per window, default_mode outside
+TEST_CASE("mode schedule overrides mode and sigma per window") {
   const int n = 5000;
   const auto truths = still_target(n, 20e3);  // t = 0 .. 49.99 s
   const auto ms = measure(R"(
@@ -344,7 +351,8 @@ TEST_CASE("mode schedule: mode and sigma overrides per window, default_mode outs
   }
 }
 
-TEST_CASE("invalid schedule: measurements in its windows are flagged invalid, finite, with the same draws") {
+// invalid schedule: measurements in its windows are flagged invalid, finite, with the same draws
+TEST_CASE("invalid schedule flags measurements in its windows") {
   std::vector<Truth> truths;
   for (int k = 0; k <= 100; ++k) truths.push_back(truth_at(0.1 * k, Vec3(1000 + 50 * k, 2000, 300), Vec3(500, 0, 0)));
   const auto plain = measure("range_rate: true", truths, 6);
@@ -364,7 +372,8 @@ TEST_CASE("invalid schedule: measurements in its windows are flagged invalid, fi
   CHECK(invalid == 15 + 11);
 }
 
-TEST_CASE("all options on: same seed, same output; another seed, another") {
+// all options on: same seed, same output; another seed, another
+TEST_CASE("all options on: output is determined by the seed") {
   std::vector<Truth> truths;
   for (int k = 0; k < 300; ++k) truths.push_back(truth_at(0.025 * k, Vec3(20e3 + 100 * k, 5e3, 2e3), Vec3(4000, 0, 50)));
   const std::string yaml = R"(
@@ -396,7 +405,8 @@ TEST_CASE("all options on: same seed, same output; another seed, another") {
   CHECK(differing == static_cast<int>(a.size()));
 }
 
-TEST_CASE("the snr model stays finite at the radar and far beyond any sensible range") {
+// the snr model stays finite at the radar and far beyond any sensible range
+TEST_CASE("snr model stays finite at zero and huge range") {
   const std::vector<Truth> truths = {truth_at(0, Vec3::Zero(), Vec3(10, 0, 0)), truth_at(1, 1e-9 * kDirection),
                                      truth_at(2, 1e12 * kDirection), truth_at(3, 1e300 * kDirection)};
   for (const char* extra : {"", "\nshot_noise: true\nshot_offset: 0\nshot_length: 4\nshot_period: 4"}) {
@@ -413,7 +423,8 @@ TEST_CASE("the snr model stays finite at the radar and far beyond any sensible r
   }
 }
 
-TEST_CASE("noise options that conflict or do not apply are refused, naming the parameter") {
+// noise options that conflict or do not apply are refused, naming the parameter
+TEST_CASE("conflicting noise options are refused") {
   struct Case {
     const char* yaml;
     const char* name;

@@ -58,7 +58,8 @@ const char* kNoNoise = "sigma_range: 0 m\nsigma_azimuth: 0 rad\nsigma_elevation:
 
 }  // namespace
 
-TEST_CASE("without noise the measurement is the exact geometry, for both conventions and an offset sensor") {
+// without noise the measurement is the exact geometry, for both conventions and an offset sensor
+TEST_CASE("without noise the measurement is exact geometry") {
   const Vec3 sensor(1000, -2000, 30);
   const std::vector<Truth> truths = {
       truth_at(0.0, sensor + Vec3(5000, 0, 0), Vec3(10, 0, 0)),                 // due east, level
@@ -103,7 +104,8 @@ TEST_CASE("without noise the measurement is the exact geometry, for both convent
   }
 }
 
-TEST_CASE("range rate is off by default: a 3-element value and 3x3 covariance diag(sigma^2)") {
+// range rate is off by default: a 3-element value and 3x3 covariance diag(sigma^2)
+TEST_CASE("range rate is off by default") {
   const auto ms = measure("sigma_range: 7 m\nsigma_azimuth: 2 mrad\nsigma_elevation: 0.5 mrad",
                           {truth_at(0, Vec3(1000, 2000, 300))});
   REQUIRE(ms.size() == 1);
@@ -118,7 +120,8 @@ TEST_CASE("range rate is off by default: a 3-element value and 3x3 covariance di
   CHECK(ms[0].covariance(1, 2) == 0.0);
 }
 
-TEST_CASE("errors have the configured bias as mean and sigma as spread - channels are independent") {
+// errors have the configured bias as mean and sigma as spread - channels are independent
+TEST_CASE("errors have the configured bias and sigma") {
   const double sr = 10.0, saz = 2e-3, sel = 1.5e-3, srr = 0.5;
   const double br = 5.0, baz = -3e-3, bel = 2e-3;
   const Vec3 sensor(100, 200, 10), p(-4000, 7000, 1500), v(120, -30, 8);
@@ -161,7 +164,8 @@ TEST_CASE("errors have the configured bias as mean and sigma as spread - channel
   CHECK(std::abs(correlation(eel, err)) < 4 / root_n);
 }
 
-TEST_CASE("the same seed gives identical measurements, another seed different ones") {
+// the same seed gives identical measurements, another seed different ones
+TEST_CASE("the same seed gives identical measurements") {
   std::vector<Truth> truths;
   for (int k = 0; k < 50; ++k) truths.push_back(truth_at(0.1 * k, Vec3(3000 + 10 * k, 4000, 500), Vec3(100, 0, 0)));
   const std::string yaml = "range_rate: true";
@@ -220,7 +224,8 @@ TEST_CASE("measured azimuth is wrapped into -pi < az <= pi") {
   }
 }
 
-TEST_CASE("a target at the radar or straight overhead gives finite values") {
+// a target at the radar or straight overhead gives finite values
+TEST_CASE("a target at the radar or overhead is finite") {
   const std::vector<Truth> truths = {
       truth_at(0, Vec3(50, 60, 70), Vec3(10, -20, 5)),      // at the sensor
       truth_at(1, Vec3(50, 60, 70), Vec3::Zero()),          // at the sensor, still
@@ -246,7 +251,8 @@ TEST_CASE("a target at the radar or straight overhead gives finite values") {
   }
 }
 
-TEST_CASE("'every: 3' keeps one truth item in three, counting afresh each run") {
+// 'every: 3' keeps one truth item in three, counting afresh each run
+TEST_CASE("every: 3 keeps one truth item in three per run") {
   std::vector<Truth> truths;
   for (int k = 0; k < 10; ++k) truths.push_back(truth_at(k, Vec3(1000, 1000, 100)));
   const auto ms = measure("every: 3", truths);
@@ -265,7 +271,8 @@ TEST_CASE("'every: 3' keeps one truth item in three, counting afresh each run") 
   CHECK(out.measurements[2].time == 0.0);
 }
 
-TEST_CASE("a non-finite truth is skipped with a diagnostic, not turned into NaN") {
+// a non-finite truth is skipped with a diagnostic, not turned into NaN
+TEST_CASE("a non-finite truth is skipped with a diagnostic") {
   Diagnostics diag;
   Truth bad = truth_at(1, Vec3(1000, std::nan(""), 0));
   const auto ms = measure("{}", {truth_at(0, Vec3(1000, 0, 0)), bad, truth_at(2, Vec3(1000, 0, 0))}, 1, &diag);

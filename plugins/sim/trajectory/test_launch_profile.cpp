@@ -45,7 +45,8 @@ sim::LaunchPath path(const Vec3& pad, double azimuth_deg, bool spherical) {
 
 }  // namespace
 
-TEST_CASE("cubic spline: reproduces a cubic that meets its end conditions, and is C2 at the knots") {
+// cubic spline: reproduces a cubic that meets its end conditions, and is C2 at the knots
+TEST_CASE("cubic spline reproduces a cubic and is C2") {
   // p(x) = 2 - x + 0.5 x^2 - 0.1 x^3 has p''(x) = 1 - 0.6 x, zero at x = 5/3: natural there.
   auto p = [](double x) { return 2 - x + 0.5 * x * x - 0.1 * x * x * x; };
   auto dp = [](double x) { return -1 + x - 0.3 * x * x; };
@@ -76,7 +77,8 @@ TEST_CASE("cubic spline: reproduces a cubic that meets its end conditions, and i
   CHECK_THROWS_AS(sim::CubicSpline({0, 1, 1}, {0, 1, 2}, {}, {}), std::invalid_argument);
 }
 
-TEST_CASE("KSLV-I profile passes through every row of paper 000 Table 16") {
+// KSLV-I profile passes through every row of paper 000 Table 16
+TEST_CASE("KSLV-I profile passes through paper 000 Table 16") {
   // 5 Hz puts a sample on every table time; pad at the origin, launched due east (flat earth).
   const auto truths = fly("rate: 5 Hz\nprofile: kslv1\npad_position: [0, 0, 0]\nlaunch_azimuth: 90 deg");
   REQUIRE(truths.size() == 540 * 5 + 1);
@@ -92,7 +94,8 @@ TEST_CASE("KSLV-I profile passes through every row of paper 000 Table 16") {
   CHECK(truths[0].velocity.norm() < 1e-12);
 }
 
-TEST_CASE("KSLV-I velocity and acceleration are continuous and are the derivatives of the position") {
+// KSLV-I velocity and acceleration are continuous and are the derivatives of the position
+TEST_CASE("KSLV-I velocity and acceleration are derivatives") {
   for (bool spherical : {false, true}) {
     INFO((spherical ? "spherical" : "flat"));
     const auto lp = path(Vec3(-60e3, 80e3, 30), 160, spherical);
@@ -151,7 +154,8 @@ TEST_CASE("KSLV-I profile is physically sensible") {
   CHECK(v54 < 500);
 }
 
-TEST_CASE("the launch track starts at the pad and runs along the launch azimuth") {
+// the launch track starts at the pad and runs along the launch azimuth
+TEST_CASE("launch track starts at the pad along the azimuth") {
   const auto truths = fly("rate: 1 Hz\nprofile: kslv1\npad_position: [100 km, -20 km, 5 m]\nlaunch_azimuth: 170 deg");
   const Vec3 pad(100e3, -20e3, 5), track(std::sin(170 * kDeg), std::cos(170 * kDeg), 0);
   CHECK((truths[0].position - pad).norm() < 1e-9);
@@ -164,7 +168,8 @@ TEST_CASE("the launch track starts at the pad and runs along the launch azimuth"
   CHECK((truths.back().position - (pad + 2054e3 * track + Vec3(0, 0, 301.9e3))).norm() < 1e-6);
 }
 
-TEST_CASE("spherical earth: altitude above the sphere and great-circle downrange are kept") {
+// spherical earth: altitude above the sphere and great-circle downrange are kept
+TEST_CASE("spherical earth keeps altitude and downrange") {
   const Vec3 pad(-100e3, 30e3, 40);  // e.g. a pad 100 km west of the radar at the origin
   const auto flat = path(pad, 100, false), round = path(pad, 100, true);
   const Vec3 centre(0, 0, -sim::kEarthRadius);
@@ -189,7 +194,8 @@ TEST_CASE("spherical earth: altitude above the sphere and great-circle downrange
   CHECK(std::hypot(round0.at(540).position.x(), round0.at(540).position.y()) == Approx((R + h) * std::sin(d / R)).margin(1e-3));
 }
 
-TEST_CASE("launch sampling: start_time shifts lift-off, rate sets the samples, profile_duration cuts") {
+// launch sampling: start_time shifts lift-off, rate sets the samples, profile_duration cuts
+TEST_CASE("launch sampling: start_time/rate/profile_duration") {
   const auto truths = fly("rate: 40 Hz\nstart_time: 10 s\nprofile: kslv1\npad_position: [0, 0, 0]\n"
                           "launch_azimuth: 45 deg\nprofile_duration: 200 s");
   REQUIRE(truths.size() == 200 * 40 + 1);

@@ -57,7 +57,8 @@ void integrate_turn(Vec3& p, Vec3& v, double w, double duration, int steps) {
 
 }  // namespace
 
-TEST_CASE("constant velocity then constant acceleration follow the closed form") {
+// constant velocity then constant acceleration follow the closed form
+TEST_CASE("CV then CA segments follow the closed form") {
   const auto truths = fly(R"(
     rate: 10 Hz
     initial_position: [100 m, -200 m, 50 m]
@@ -86,7 +87,8 @@ TEST_CASE("constant velocity then constant acceleration follow the closed form")
   CHECK(truths.back().time == 9.0);
 }
 
-TEST_CASE("a full circle returns to its start with constant speed and radius v / turn_rate") {
+// a full circle returns to its start with constant speed and radius v / turn_rate
+TEST_CASE("a full circle returns to its start") {
   // Paper 002 scenario 1: radius 1500 m at 200 m/s and 150 m altitude, so turn_rate = v / R.
   const double v = 200.0, R = 1500.0, w = v / R, period = 2 * std::numbers::pi / w;
   const int samples_per_circle = 1884;  // about 40 Hz; the rate is chosen so the last sample lands on the end
@@ -113,7 +115,8 @@ TEST_CASE("a full circle returns to its start with constant speed and radius v /
   CHECK(quarter.velocity.y() > 0.99 * v);
 }
 
-TEST_CASE("a climbing turn keeps its vertical velocity and matches a fine numerical integration") {
+// a climbing turn keeps its vertical velocity and matches a fine numerical integration
+TEST_CASE("a climbing turn matches numerical integration") {
   const auto truths = fly(R"(
     rate: 4 Hz
     initial_position: [1 km, 2 km, 300 m]
@@ -129,7 +132,8 @@ TEST_CASE("a climbing turn keeps its vertical velocity and matches a fine numeri
   for (const Truth& t : truths) CHECK(t.velocity.z() == 3.0);
 }
 
-TEST_CASE("paper 002 scenario 2: a velocity change to 300 m/s with a 60 degree climb") {
+// paper 002 scenario 2: a velocity change to 300 m/s with a 60 degree climb
+TEST_CASE("paper 002 scenario 2 velocity change and climb") {
   const auto truths = fly(R"(
     rate: 40 Hz
     initial_position: [0, 0, 100 m]
@@ -154,7 +158,8 @@ TEST_CASE("paper 002 scenario 2: a velocity change to 300 m/s with a 60 degree c
   CHECK((truths.back().position - (Vec3(450, 0, 100) + 2 * after)).norm() < 1e-9);
 }
 
-TEST_CASE("velocity_change: heading alone keeps speed and climb - a full vector replaces the velocity") {
+// velocity_change: heading alone keeps speed and climb - a full vector replaces the velocity
+TEST_CASE("velocity_change by heading or by full vector") {
   const auto truths = fly(R"(
     rate: 1 Hz
     initial_position: [0, 0, 0]
@@ -186,7 +191,8 @@ TEST_CASE("a straight constant-speed descent (landing approach)") {
   for (const Truth& t : truths) CHECK(t.velocity.norm() == Approx(60));
 }
 
-TEST_CASE("landing approach (paper 001): straight constant-speed descent along the runway to a radar at touchdown") {
+// landing approach (paper 001): straight constant-speed descent along the runway to a radar at touchdown
+TEST_CASE("paper 001 landing approach to a touchdown radar") {
   // Runway along +x (heading 090), radar at the touchdown point (the origin); 3 deg glide slope from
   // 5 km out at 60 m/s. Existing segments express it: a velocity_change, then constant velocity until
   // the track reaches the radar.
@@ -210,7 +216,8 @@ TEST_CASE("landing approach (paper 001): straight constant-speed descent along t
   CHECK(truths.back().position.norm() < speed * 0.1 + 1e-9);
 }
 
-TEST_CASE("sample times are start_time + k / rate up to the end, inclusive") {
+// sample times are start_time + k / rate up to the end, inclusive
+TEST_CASE("sample times are start_time + k / rate inclusive") {
   SECTION("10 Hz from 2 s over 3 s") {
     const auto truths = fly("rate: 10 Hz\nstart_time: 2 s\ninitial_position: [0, 0, 0]\n"
                             "segments: [{type: constant_velocity, duration: 3 s}]");
@@ -252,7 +259,7 @@ TEST_CASE("sample times are start_time + k / rate up to the end, inclusive") {
   }
 }
 
-TEST_CASE("inconsistent segment records are refused with the field named") {
+TEST_CASE("inconsistent segments are refused naming the field") {
   const std::string head = "initial_position: [0, 0, 0]\ninitial_velocity: [10, 0, 0]\nsegments:\n";
   struct Case {
     const char* segment;
@@ -285,7 +292,8 @@ TEST_CASE("inconsistent segment records are refused with the field named") {
              Catch::Matchers::Contains("segment 2"));
 }
 
-TEST_CASE("keeping the direction of a zero or vertical velocity is refused - a vertical target is fine") {
+// keeping the direction of a zero or vertical velocity is refused - a vertical target is fine
+TEST_CASE("keeping a zero or vertical direction is refused") {
   const std::string still = "initial_position: [0, 0, 0]\nsegments:\n";
   CHECK_THAT(config_error(still + "  - {type: velocity_change, speed: 100}\n"), Catch::Matchers::Contains("'climb'"));
   CHECK_THAT(config_error(still + "  - {type: velocity_change, speed: 100, climb: 10 deg}\n"),

@@ -151,7 +151,8 @@ double num(const std::string& cell) { return std::stod(cell); }
 
 }  // namespace
 
-TEST_CASE("the file has the header, one row per estimate and run, 28 cells each, no nan") {
+// the file has the header, one row per estimate and run, 28 cells each, no nan
+TEST_CASE("the file has the header and one full row per estimate") {
   const fs::path dir = scratch("basic") / "nested";  // --out need not exist yet
   const std::string text = ensemble_file(dir, {0, 1, 2}, 1, [](std::uint64_t) { return 0; });
   const auto rows = parse(text);
@@ -169,7 +170,8 @@ TEST_CASE("the file has the header, one row per estimate and run, 28 cells each,
   CHECK(rows[1][Kind] == "estimate");
 }
 
-TEST_CASE("cells hold the estimate, its sigmas, NIS, NEES and the matching truth") {
+// cells hold the estimate, its sigmas, NIS, NEES and the matching truth
+TEST_CASE("cells hold the estimate/sigmas/NIS/NEES/truth") {
   const fs::path dir = scratch("values");
   const auto rows = parse(ensemble_file(dir, {0, 1}, 1, [](std::uint64_t) { return 0; }));
   // Run 1, step 1, filter kf: truth (1010, 2001, 300, -100, 50, 0), error +1 everywhere.
@@ -197,7 +199,8 @@ TEST_CASE("cells hold the estimate, its sigmas, NIS, NEES and the matching truth
   CHECK(!coast[Nees].empty());
 }
 
-TEST_CASE("cells without a value are empty: no truth at that time, non-positive covariance") {
+// cells without a value are empty: no truth at that time, non-positive covariance
+TEST_CASE("cells without a value are empty") {
   const fs::path dir = scratch("empty");
   auto c = make_csv("{}");
   Diagnostics diag;
@@ -228,7 +231,7 @@ TEST_CASE("cells without a value are empty: no truth at that time, non-positive 
   CHECK(s.find("rows")->value == 2);
 }
 
-TEST_CASE("annotation columns carry what an adapter published on the estimate and are empty where there is none") {
+TEST_CASE("annotation columns carry adapter values or stay empty") {
   const fs::path dir = scratch("quality");
   auto c = make_csv("{}");
   Diagnostics diag;
@@ -253,7 +256,8 @@ TEST_CASE("annotation columns carry what an adapter published on the estimate an
   for (int col : {QR, QAZ, QEL}) CHECK(rows[2][col].empty());
 }
 
-TEST_CASE("the file is byte-identical whatever the worker assignment, run order and item order within a step") {
+// the file is byte-identical whatever the worker assignment, run order and item order within a step
+TEST_CASE("the file is byte-identical whatever the order") {
   const std::string serial = ensemble_file(scratch("serial"), {0, 1, 2, 3}, 1, [](std::uint64_t) { return 0; });
   const std::string interleaved = ensemble_file(scratch("two"), {0, 1, 2, 3}, 2, [](std::uint64_t r) { return int(r % 2); });
   const std::string reversed = ensemble_file(scratch("rev"), {3, 1, 2, 0}, 3, [](std::uint64_t r) { return int(r % 3); });
@@ -264,7 +268,8 @@ TEST_CASE("the file is byte-identical whatever the worker assignment, run order 
   CHECK(truth_last == serial);
 }
 
-TEST_CASE("measurement rows: Cartesian position, sigmas when Cartesian, truth, no filter columns") {
+// measurement rows: Cartesian position, sigmas when Cartesian, truth, no filter columns
+TEST_CASE("measurement rows have position sigmas and truth") {
   const fs::path dir = scratch("meas");
   auto c = make_csv("{ include_measurements: true, precision: 12 }", {kKf, kTruth, kCm});
   Diagnostics diag;
@@ -325,7 +330,8 @@ TEST_CASE("measurement rows: Cartesian position, sigmas when Cartesian, truth, n
   CHECK(s2.find("rows")->value == 0);
 }
 
-TEST_CASE("path is relative to the output folder; precision sets significant digits") {
+// path is relative to the output folder; precision sets significant digits
+TEST_CASE("relative path and precision") {
   const fs::path dir = scratch("path");
   auto c = make_csv("{ path: sub/run.csv, precision: 4 }", {kKf});
   Diagnostics diag;

@@ -55,7 +55,8 @@ double metric(const Summary& s, const std::string& name) {
 
 }  // namespace
 
-TEST_CASE("per-interval filter and measurement RMSE, ratios and the largest ratio over two runs") {
+// per-interval filter and measurement RMSE, ratios and the largest ratio over two runs
+TEST_CASE("per-interval RMSE and ratios over two runs") {
   auto sink = test::make("sink.interval_rmse", "{ interval: 10 s }");
   feed(*sink, 0, [](double t) { return t < 10 ? 2.0 : 1.0; }, [](double t) { return t < 20 ? 4.0 : 0.5; });
   feed(*sink, 1, [](double t) { return t < 10 ? -4.0 : 1.0; }, [](double t) { return t < 20 ? -2.0 : 0.5; });
@@ -73,7 +74,8 @@ TEST_CASE("per-interval filter and measurement RMSE, ratios and the largest rati
   CHECK(metric(s, "non_finite_estimates") == 0);
 }
 
-TEST_CASE("skip_initial and start move the intervals; the wiring must be one filter and one measurement stream") {
+// skip_initial and start move the intervals; the wiring must be one filter and one measurement stream
+TEST_CASE("skip_initial/start and the required wiring") {
   auto sink = test::make("sink.interval_rmse", "{ interval: 10 s, start: 5 s, skip_initial: 3 s }");
   feed(*sink, 0, [](double t) { return t; }, [](double) { return 1.0; });
   Summary s;

@@ -96,7 +96,8 @@ double wilson_hilferty(double k, double z) {
 
 }  // namespace
 
-TEST_CASE("RMSE, bias and max per-step RMS match a hand computation over 3 steps and 2 runs") {
+// RMSE, bias and max per-step RMS match a hand computation over 3 steps and 2 runs
+TEST_CASE("RMSE bias and max RMS match a hand computation") {
   // Errors (position; velocity) per run and step, truth moving along x.
   const Vec6 err[2][3] = {{state(1, 2, 0, 1, 0, 0), state(-1, 0, 2, 0, 0, 0), state(0, 0, 0, 0, 2, 0)},
                           {state(3, 0, 0, 0, 0, -1), state(1, 2, 2, 0, 0, 0), state(0, -2, 0, 1, 1, 0)}};
@@ -134,7 +135,8 @@ TEST_CASE("RMSE, bias and max per-step RMS match a hand computation over 3 steps
   CHECK(value(s, "anees_position") == Approx((14 + 14 + 4) / (3 * 3 * 2.0)));
 }
 
-TEST_CASE("the ANEES band for n=6, M=100 is [0.890, 1.116] and for n=3 [0.846, 1.166]") {
+// the ANEES band for n=6, M=100 is [0.890, 1.116] and for n=3 [0.846, 1.166]
+TEST_CASE("ANEES bands for n=6 and n=3 with M=100") {
   auto s = run_ensemble("{}", {kFilter, kTruth}, 100, [](Component& c, int) {
     c.on_truth(truth(0, Vec3::Zero()), 1);
     c.on_estimate(estimate(0, state(1, 1, 1, 1, 1, 1)), 0);
@@ -152,7 +154,8 @@ TEST_CASE("the ANEES band for n=6, M=100 is [0.890, 1.116] and for n=3 [0.846, 1
   CHECK(a->value == Approx(1.0));  // unit error in every component, identity covariance
 }
 
-TEST_CASE("a consistent estimator's ANEES and ANIS lie inside their bands; an overconfident one's do not") {
+// a consistent estimator's ANEES and ANIS lie inside their bands; an overconfident one's do not
+TEST_CASE("ANEES and ANIS bands tell consistent estimators") {
   constexpr int kRuns = 200, kSteps = 50;
   Rng setup(42);
   const Mat6 P = random_covariance(setup);
@@ -213,7 +216,8 @@ TEST_CASE("a consistent estimator's ANEES and ANIS lie inside their bands; an ov
   }
 }
 
-TEST_CASE("estimates between truth samples are compared with linearly interpolated truth") {
+// estimates between truth samples are compared with linearly interpolated truth
+TEST_CASE("estimates use linearly interpolated truth") {
   auto s = run_ensemble("{}", {kFilter, kTruth}, 1, [](Component& c, int) {
     c.on_truth(truth(0.0, Vec3(0, 0, 0), Vec3(1, 2, 3)), 1);
     c.on_truth(truth(1.0, Vec3(10, 20, 30), Vec3(3, 4, 5)), 1);
@@ -228,7 +232,8 @@ TEST_CASE("estimates between truth samples are compared with linearly interpolat
   CHECK(value(s, "steps") == 2);
 }
 
-TEST_CASE("estimates outside the truth's time span are counted as unmatched, not scored") {
+// estimates outside the truth's time span are counted as unmatched, not scored
+TEST_CASE("estimates outside the truth span are unmatched") {
   auto s = run_ensemble("{}", {kFilter, kTruth}, 2, [](Component& c, int) {
     c.on_estimate(estimate(0.5, state(100, 100, 100)), 0);  // before the first truth sample
     c.on_truth(truth(1.0, Vec3::Zero()), 1);
@@ -243,7 +248,8 @@ TEST_CASE("estimates outside the truth's time span are counted as unmatched, not
   CHECK(has_note(s, "outside the truth's time span"));
 }
 
-TEST_CASE("skip_initial leaves out the transient after the first initialised estimate") {
+// skip_initial leaves out the transient after the first initialised estimate
+TEST_CASE("skip_initial leaves out the initial transient") {
   auto s = run_ensemble("{ skip_initial: 3 s }", {kFilter, kTruth}, 1, [](Component& c, int) {
     Estimate early = estimate(0.0, state(1000, 0, 0));
     early.initialised = false;  // not yet initialised: neither scored nor the start of the transient
@@ -259,7 +265,8 @@ TEST_CASE("skip_initial leaves out the transient after the first initialised est
   CHECK(has_note(s, "skip_initial"));
 }
 
-TEST_CASE("converted measurements give the measurement RMSE baseline and rmse_ratio") {
+// converted measurements give the measurement RMSE baseline and rmse_ratio
+TEST_CASE("measurements give the RMSE baseline and rmse_ratio") {
   auto s = run_ensemble("{}", {kFilter, kTruth, kConverted}, 2, [](Component& c, int r) {
     const Vec3 p(3000, 4000, 500);
     c.on_truth(truth(0.0, p), 1);
@@ -315,7 +322,7 @@ TEST_CASE("without truth only innovation statistics are reported") {
   CHECK(value(s, "estimates") == 12);
 }
 
-TEST_CASE("metrics with no data are skipped with a note, never NaN") {
+TEST_CASE("metrics with no data are skipped with a note") {
   auto s = run_ensemble("{}", {kFilter, kTruth}, 2, [](Component& c, int) {
     c.on_truth(truth(0.0, Vec3::Zero()), 1);
     Estimate e = estimate(0.0, state(1, 0, 0));
@@ -329,7 +336,8 @@ TEST_CASE("metrics with no data are skipped with a note, never NaN") {
   CHECK(has_note(s, "anis"));
 }
 
-TEST_CASE("more than one estimate input, or a confidence outside (0, 1), is a configuration error") {
+// more than one estimate input, or a confidence outside (0, 1), is a configuration error
+TEST_CASE("bad inputs or confidence are config errors") {
   auto sink = test::make("sink.metrics", "{}", "score");
   const InputInfo other{"ekf", "filter.ekf", mask(ItemKind::Estimate)};
   CHECK_THROWS_WITH(sink->set_inputs({kFilter, kTruth, other}), Catch::Contains("use one sink.metrics per filter"));

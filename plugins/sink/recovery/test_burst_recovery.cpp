@@ -46,7 +46,8 @@ std::vector<double> errors() {
 
 }  // namespace
 
-TEST_CASE("recovery samples with hold 1 and hold 2, censoring at the end of the run, peak error") {
+// recovery samples with hold 1 and hold 2, censoring at the end of the run, peak error
+TEST_CASE("recovery with hold 1 and 2 and censoring") {
   const auto s = series(errors());
   const RunStats one = evaluate(s, settings(1));
   REQUIRE(one.bursts.size() == 3);
@@ -66,7 +67,8 @@ TEST_CASE("recovery samples with hold 1 and hold 2, censoring at the end of the 
   CHECK(two.bursts[1].samples == 0);
 }
 
-TEST_CASE("a burst is judged only up to the next burst, and not at all when no sample follows it") {
+// a burst is judged only up to the next burst, and not at all when no sample follows it
+TEST_CASE("a burst is judged only up to the next burst") {
   std::vector<double> e(31, 0.5);
   for (int k = 10; k < 20; ++k) e[k] = 5.0;  // never back before burst 2 at 20
   e[30] = 5.0;                                // burst 3 starts at 30, nothing after 31
@@ -77,7 +79,8 @@ TEST_CASE("a burst is judged only up to the next burst, and not at all when no s
   CHECK(r.bursts[1].recovered);
 }
 
-TEST_CASE("the RMSE leaves out burst samples and exclude_after tails, and unscored samples") {
+// the RMSE leaves out burst samples and exclude_after tails, and unscored samples
+TEST_CASE("RMSE leaves out bursts and exclude_after tails") {
   auto s = series(errors());
   s[3].scored = false;  // e.g. the initial transient
   double sq = 0, n = 0, sq_tail = 0, n_tail = 0;
@@ -102,7 +105,8 @@ TEST_CASE("the RMSE leaves out burst samples and exclude_after tails, and unscor
   CHECK(r1.sq_error == Approx(sq_tail));
 }
 
-TEST_CASE("samples without an error (not initialised, non-finite) never count as recovered") {
+// samples without an error (not initialised, non-finite) never count as recovered
+TEST_CASE("samples without an error never count as recovered") {
   std::vector<double> e(25, 0.5);
   e[12] = std::numeric_limits<double>::infinity();
   const RunStats r = evaluate(series(e), settings(1));

@@ -51,7 +51,8 @@ double metric(const Summary& s, const char* name) {
 
 }  // namespace
 
-TEST_CASE("recovery metrics, peak error and RMSE outside bursts over two runs") {
+// recovery metrics, peak error and RMSE outside bursts over two runs
+TEST_CASE("recovery metrics over two runs") {
   // Bursts of 3 samples at 10, 30 (period 20). Run 0 recovers 4 samples after burst 1 and at
   // once after burst 2; run 1 needs 6 and 1.
   auto sink = test::make("sink.recovery", "{ shot_length: 3, shot_period: 20, shot_offset: 10, threshold: 2 m }");
@@ -92,7 +93,8 @@ TEST_CASE("recovery metrics, peak error and RMSE outside bursts over two runs") 
   CHECK(metric(s, "rmse_excluding_bursts") == Approx(std::sqrt(sq / n)));
 }
 
-TEST_CASE("skip_initial leaves the transient out of the RMSE; hold requires consecutive samples") {
+// skip_initial leaves the transient out of the RMSE; hold requires consecutive samples
+TEST_CASE("skip_initial and consecutive hold samples") {
   auto sink = test::make("sink.recovery",
                          "{ shot_length: 3, shot_period: 20, shot_offset: 10, threshold: 2 m, hold: 3, skip_initial: 1 s }");
   // Large error in the first second after initialisation (t 0.3 .. 1.2); after burst 1 a single
@@ -121,7 +123,8 @@ TEST_CASE("skip_initial leaves the transient out of the RMSE; hold requires cons
   CHECK(metric(s, "rmse_excluding_bursts") == Approx(std::sqrt(sq / n)));
 }
 
-TEST_CASE("sink.recovery refuses two filters and an exclusion longer than the period") {
+// sink.recovery refuses two filters and an exclusion longer than the period
+TEST_CASE("refuses two filters and too long an exclusion") {
   auto sink = test::make("sink.recovery", "{ threshold: 10 m }");
   const std::vector<InputInfo> two = {{"a", "filter.ekf", mask(ItemKind::Estimate)},
                                       {"b", "filter.ekf", mask(ItemKind::Estimate)}};

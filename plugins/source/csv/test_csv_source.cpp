@@ -79,7 +79,8 @@ void check_finite(const Measurement& m) {
 
 }  // namespace
 
-TEST_CASE("spherical rows are converted from km, degrees and milliseconds to SI") {
+// spherical rows are converted from km, degrees and milliseconds to SI
+TEST_CASE("spherical rows in km/deg/ms are converted to SI") {
   TempDir dir;
   const std::string file = dir.write("log.csv",
                                      "time,range,azimuth,elevation\n"
@@ -116,7 +117,7 @@ TEST_CASE("spherical rows are converted from km, degrees and milliseconds to SI"
   }
 }
 
-TEST_CASE("angles in rad and mrad, range in metres, time in seconds") {
+TEST_CASE("angles in rad/mrad with range and time in SI") {
   TempDir dir;
   const std::string file = dir.write("log.csv", "time,range,azimuth,elevation\n0.25,800,-1.5,0.2\n");
   const auto rad = read_all(file, "angle_unit: rad");
@@ -130,7 +131,8 @@ TEST_CASE("angles in rad and mrad, range in metres, time in seconds") {
   CHECK(mrad.at(0).value(2) == Approx(0.2e-3));
 }
 
-TEST_CASE("cartesian rows are positions in the ENU frame with an isotropic covariance") {
+// cartesian rows are positions in the ENU frame with an isotropic covariance
+TEST_CASE("cartesian rows are ENU positions") {
   TempDir dir;
   const std::string file = dir.write("xyz.csv",
                                      "t,east,north,up,rdot\n"
@@ -155,7 +157,8 @@ TEST_CASE("cartesian rows are positions in the ENU frame with an isotropic covar
   CHECK(ms[0].covariance(0, 3) == 0.0);
 }
 
-TEST_CASE("optional columns: range rate, SNR, mode, validity, sensor; extra columns and quotes; CRLF") {
+// optional columns: range rate, SNR, mode, validity, sensor; extra columns and quotes; CRLF
+TEST_CASE("optional and extra columns with quotes and CRLF") {
   TempDir dir;
   const std::string file = dir.write("opt.csv",
                                      "\"time\",range,azimuth,elevation,rr,snr,mode,ok,radar,comment\r\n"
@@ -188,7 +191,8 @@ TEST_CASE("optional columns: range rate, SNR, mode, validity, sensor; extra colu
   }
 }
 
-TEST_CASE("emits one measurement per call in file order; start_run rewinds") {
+// emits one measurement per call in file order; start_run rewinds
+TEST_CASE("one measurement per call in order and rewind") {
   TempDir dir;
   const std::string file = dir.write("log.csv", "time,range,azimuth,elevation\n0,1,0,0\n0.5,2,0,0\n2,3,0,0\n");
   auto src = test::make("source.csv", yaml_params(file));
@@ -212,14 +216,16 @@ TEST_CASE("emits one measurement per call in file order; start_run rewinds") {
   CHECK(diag.skips.empty());
 }
 
-TEST_CASE("blank lines at the end and a complete last line without newline are accepted") {
+// blank lines at the end and a complete last line without newline are accepted
+TEST_CASE("trailing blank lines and missing final newline") {
   TempDir dir;
   CHECK(read_all(dir.write("a.csv", "time,range,azimuth,elevation\n0,1,0,0\n1,2,0,0\n\n  \r\n\n")).size() == 2);
   CHECK(read_all(dir.write("b.csv", "time,range,azimuth,elevation\n0,1,0,0\n1,2,0,0")).size() == 2);
   CHECK(read_all(dir.write("c.csv", "time,range,azimuth,elevation\r\n0,1,0,0\r\n1,2,0,0")).size() == 2);
 }
 
-TEST_CASE("each kind of bad row is a DataError naming the file and the line") {
+// each kind of bad row is a DataError naming the file and the line
+TEST_CASE("bad rows are DataErrors naming file and line") {
   TempDir dir;
   const std::string header = "time,range,azimuth,elevation\n";
   struct Case {
@@ -265,7 +271,8 @@ TEST_CASE("each kind of bad row is a DataError naming the file and the line") {
   }
 }
 
-TEST_CASE("on_bad_row: skip leaves out exactly the bad rows and reports each once") {
+// on_bad_row: skip leaves out exactly the bad rows and reports each once
+TEST_CASE("on_bad_row skip drops and reports each bad row") {
   TempDir dir;
   const std::string file = dir.write("mixed.csv",
                                      "time,range,azimuth,elevation\n"  // 1
@@ -305,14 +312,16 @@ TEST_CASE("on_bad_row: skip leaves out exactly the bad rows and reports each onc
   CHECK(summary.find("skipped_rows")->value == 5);
 }
 
-TEST_CASE("an empty file or a header without rows is an error even with on_bad_row: skip") {
+// an empty file or a header without rows is an error even with on_bad_row: skip
+TEST_CASE("an empty file is an error even with skip") {
   TempDir dir;
   CHECK_THAT(data_error(dir, "e.csv", "", "on_bad_row: skip"), Catch::Matchers::Contains("e.csv"));
   CHECK_THAT(data_error(dir, "h.csv", "time,range,azimuth,elevation\n", "on_bad_row: skip"),
              Catch::Matchers::Contains("h.csv:1:"));
 }
 
-TEST_CASE("a missing column names the file, the header line and the columns, and suggests the close name") {
+// a missing column names the file, the header line and the columns, and suggests the close name
+TEST_CASE("a missing column is named with a suggestion") {
   TempDir dir;
   const std::string message = data_error(dir, "cols.csv", "time,rnage,azimuth,Elevation\n0,1,0,0\n");
   CHECK_THAT(message, Catch::Matchers::Contains("cols.csv:1:"));
@@ -358,7 +367,8 @@ TEST_CASE("parameter mistakes are configuration errors") {
   }
 }
 
-TEST_CASE("a relative path is relative to the folder of the pipeline file that wrote it") {
+// a relative path is relative to the folder of the pipeline file that wrote it
+TEST_CASE("a relative path is relative to the pipeline file") {
   TempDir dir;
   const std::string pipeline = dir.write("pipelines/p.yaml", "# stands in for the pipeline file\n");
   dir.write("pipelines/data/rel.csv", "time,range,azimuth,elevation\n0,42,0,0\n");
