@@ -283,12 +283,9 @@ TEST_CASE("spherical measurement is a config error naming the node") {
   f->start_run({0, 1, &diag});
   Measurement m = cartesian(0.0, Vec3(1000, 0.1, 0.02), Vec3::Ones());
   m.frame = Frame::Spherical;
-  try {
-    f->on_measurement(m, 0);
-    FAIL("no error");
-  } catch (const ConfigError& e) {
-    CHECK_THAT(e.message(), Catch::Contains("my_ab") && Catch::Contains("convert.classical"));
-  }
+  // The SDK's front end refuses it as a data error naming the filter, the node and the fix.
+  CHECK_THROWS_AS(f->on_measurement(m, 0), DataError);
+  CHECK_THROWS_WITH(f->on_measurement(m, 0), Catch::Contains("my_ab") && Catch::Contains("convert."));
 }
 
 // a time step of zero or less skips the update with a warning and invalid measurements coast
@@ -300,17 +297,21 @@ TEST_CASE("non-positive time step skips update and invalid coasts") {
   f->start_run({0, 1, &diag});
   f->on_measurement(cartesian(0.0, Vec3(0, 0, 0), Vec3::Ones()), 0);
   f->on_measurement(cartesian(1.0, Vec3(2, 0, 0), Vec3::Ones()), 0);
-  f->on_measurement(cartesian(1.0, Vec3(50, 0, 0), Vec3::Ones()), 0);  // same time
-  f->on_measurement(cartesian(0.5, Vec3(50, 0, 0), Vec3::Ones()), 0);  // older
-  REQUIRE(out.estimates.size() == 2);
-  REQUIRE(diag.warnings.size() == 2);
+  f->on_measurement(cartesian(1.0, Vec3(50, 0, 0), Vec3::Ones()), 0);  // same time: published, not used
+  f->on_measurement(cartesian(0.5, Vec3(50, 0, 0), Vec3::Ones()), 0);  // older: skipped by the front end
+  REQUIRE(out.estimates.size() == 3);
+  CHECK_FALSE(out.estimates[2].updated);
+  CHECK(out.estimates[2].enu(0) == 2.0);
+  REQUIRE(diag.warnings.size() == 1);
   CHECK(diag.warnings[0].node == "ab");
   CHECK_THAT(diag.warnings[0].message, Catch::Contains("not later"));
+  REQUIRE(diag.skips.size() == 1);
+  CHECK_THAT(diag.skips[0].message, Catch::Contains("older"));
 
   Measurement lost = cartesian(2.0, Vec3(0, 0, 0), Vec3::Ones());
   lost.valid = false;
   f->on_measurement(lost, 0);
-  REQUIRE(out.estimates.size() == 3);
+  REQUIRE(out.estimates.size() == 4);
   const Estimate& e = out.estimates.back();
   CHECK_FALSE(e.updated);
   CHECK(e.innovation.size() == 0);

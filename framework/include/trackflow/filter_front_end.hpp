@@ -189,7 +189,9 @@ class FilterFrontEnd : public Filter {
     if (m.frame != spec_.frame)
       throw DataError(who() + " takes " + to_string(spec_.frame) + " measurements, but the one at t=" +
                       std::to_string(m.time) + " s is " + to_string(m.frame) +
-                      (spec_.frame == Frame::Cartesian ? "; put a convert.* node between the radar and it" : ""));
+                      (spec_.frame == Frame::Cartesian
+                           ? "; put a convert.* node between the radar and it"
+                           : "; for Cartesian (converted) measurements use filter.kalman or filter.decoupled"));
     if (!well_formed)
       throw DataError(who() + ": measurement at t=" + std::to_string(m.time) + " s has " + std::to_string(n) +
                       " values and a " + std::to_string(m.covariance.rows()) + "x" +

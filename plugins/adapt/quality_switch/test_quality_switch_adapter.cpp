@@ -69,6 +69,8 @@ struct Attached {
     REQUIRE(noise_mismatch(a->needs(), f->noise(), f->has_covariance_access()).empty());
     REQUIRE(f->attach(a, static_cast<int>(a->annotation_names().size())));
     out.attach_to(*filter);
+    f->save_configured_noise();  // as the engine does once the graph is built
+    f->reset_adapted_state();
     filter->start_run({0, 1, &diag});
     adapter->start_run({0, 1, &diag});
   }
@@ -222,6 +224,7 @@ TEST_CASE("unlocked run start restores the filter's own q") {
   Attached s;
   for (int k = 0; k < 5; ++k) s.step(meas(0.025 * k, kR0 + 0.5 * k));
   REQUIRE(s.f->noise().process.values[0] != 7.0);  // adapted
+  s.f->reset_adapted_state();  // the engine, at the start of every run
   s.filter->start_run({1, 1, &s.diag});
   s.adapter->start_run({1, 1, &s.diag});
   s.step(meas(0.0, 0.0, 0.0, 0.0, MeasMode::Beacon, /*valid=*/false));
@@ -230,7 +233,7 @@ TEST_CASE("unlocked run start restores the filter's own q") {
   CHECK(s.f->noise().process.values[0] != 7.0);  // geometry known: the table's again
 }
 
-TEST_CASE("a line-of-sight q gets channel PSDs scaled at the estimate") {
+TEST_CASE("line-of-sight q gets channel PSDs scaled") {
   struct StubFilter : Filter {
     MeasCov R = MeasCov::Identity(3, 3);
     double q[3] = {-1, -1, -1};

@@ -72,6 +72,7 @@ class SphericalEkf final : public FilterFrontEnd<SphericalEkf> {
     guard_steps_ = 0;
     predictions_ = 0;
     folds_ = 0;
+    zenith_reported_ = false;
     if (!s_.two_point) {
       x_ = s_.x0;
       P_ = s_.P0;
@@ -153,6 +154,10 @@ class SphericalEkf final : public FilterFrontEnd<SphericalEkf> {
       R.col(1).setZero();
       R(1, 1) = raz > 0.0 ? raz : 1.0;
       count(kAzimuthDropped);
+      if (!zenith_reported_)
+        warn("target near the zenith at t=" + std::to_string(m.time) + " s: azimuth not used (the vertical axis "
+             "within 3 sigma of the predicted position); counted in the summary, reported once per run");
+      zenith_reported_ = true;
     }
     if (std::abs(x_(kPhi)) > kNearZenith || std::abs(z(2)) > kNearZenith)
       nearer_representation<M>(H, drop_azimuth, z, R);
@@ -246,7 +251,7 @@ class SphericalEkf final : public FilterFrontEnd<SphericalEkf> {
   EnuJacobian J_enu_ = EnuJacobian::Zero();
   Eigen::Matrix<double, 6, kDim> JP_ = Eigen::Matrix<double, 6, kDim>::Zero();
   double last_T_ = -1.0;
-  bool has_sensor_ = false;
+  bool has_sensor_ = false, zenith_reported_ = false;
   Vec3 sensor_ = Vec3::Zero();
   AzimuthConvention convention_ = AzimuthConvention::NorthClockwise;
   int points_ = 0;

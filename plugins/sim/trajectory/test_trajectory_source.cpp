@@ -427,7 +427,7 @@ TEST_CASE("process noise increments have the CV model covariance") {
   check_cov(end_sum / R, model(K * T), R);  // R = 400: 5 sd is 35 % on a diagonal entry
 }
 
-TEST_CASE("process noise: same seed same path - another run another path") {
+TEST_CASE("process noise: same seed same path - new run new path") {
   const std::string yaml = kManoeuvres + "process_noise_q: 2 m2/s3\n";
   auto gen = test::make("sim.trajectory", yaml, "truth");
   auto run = [&](std::uint64_t r) {
