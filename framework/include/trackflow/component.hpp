@@ -2,6 +2,7 @@
 #pragma once
 
 #include <trackflow/items.hpp>
+#include <trackflow/series.hpp>
 
 #include <boost/config.hpp>
 
@@ -58,6 +59,7 @@ struct Summary {
   std::vector<Metric> metrics;
   std::vector<std::string> notes;
   std::vector<std::string> files;
+  std::vector<Series> series;  // per-step tables for `run --series` and `trackflow report` (appended: old plugins never touch it)
   void metric(std::string name, double v, std::string unit = {}) {
     metrics.push_back({std::move(name), v, std::move(unit)});
   }

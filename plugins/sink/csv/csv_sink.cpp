@@ -21,6 +21,12 @@ constexpr const char* kHeader =
     "run,time,source,kind,updated,x,y,z,vx,vy,vz,sigma_x,sigma_y,sigma_z,sigma_vx,sigma_vy,sigma_vz,nis,nees,"
     "truth_x,truth_y,truth_z,truth_vx,truth_vy,truth_vz,quality_range,quality_azimuth,quality_elevation\n";
 
+// Opt-in (full_covariance): the upper triangle of the ENU covariance, row by row; units m2,
+// m2/s and m2/s2 (the sigma_* columns are the square roots of its diagonal).
+constexpr const char* kCovarianceHeader =
+    ",cov_x_x,cov_x_y,cov_x_z,cov_x_vx,cov_x_vy,cov_x_vz,cov_y_y,cov_y_z,cov_y_vx,cov_y_vy,cov_y_vz,cov_z_z,cov_z_vx,"
+    "cov_z_vy,cov_z_vz,cov_vx_vx,cov_vx_vy,cov_vx_vz,cov_vy_vy,cov_vy_vz,cov_vz_vz";
+
 // Truth samples within this of an item's time are its truth (the same default as sink.metrics).
 constexpr double kTimeTolerance = 1e-6;
 
@@ -51,6 +57,7 @@ class CsvSink final : public Component {
       : path_(p.has("path") ? p.text("path") : std::string()),
         path_where_(p.where("path")),
         include_measurements_(p.boolean("include_measurements")),
+        full_covariance_(p.boolean("full_covariance")),
         precision_(static_cast<int>(p.integer("precision"))) {
     if (p.has("path") && path_.empty()) throw p.error("path", "must not be empty (leave it out for '<node id>.csv')");
     truth_.reserve(4096);
@@ -115,6 +122,7 @@ class CsvSink final : public Component {
       r.has_sigma = m.covariance.rows() >= 3 && m.covariance.cols() >= 3;
       for (int i = 0; i < 3 && r.has_sigma; ++i)
         r.sigma(i) = m.covariance(i, i) >= 0.0 ? std::sqrt(m.covariance(i, i)) : NAN;
+      if (r.has_sigma) r.covariance.topLeftCorner<3, 3>() = m.covariance.topLeftCorner(3, 3);
     } else {
       r.value.head<3>() = spherical_to_enu(m.value(0), m.value(1), m.value(2), m.azimuth) + m.sensor_position;
     }
@@ -144,7 +152,12 @@ class CsvSink final : public Component {
     if (ec) throw ConfigError("cannot create the folder '" + file.parent_path().string() + "': " + ec.message(), path_where_, ctx.node);
     std::ofstream os(file, std::ios::binary | std::ios::trunc);
     if (os) {
-      os << kHeader;
+      if (full_covariance_) {
+        const std::string h(kHeader);
+        os << h.substr(0, h.size() - 1) << kCovarianceHeader << '\n';
+      } else {
+        os << kHeader;
+      }
       os.write(file_.data(), static_cast<std::streamsize>(file_.size()));
       os.flush();
     }
@@ -222,6 +235,9 @@ class CsvSink final : public Component {
       else
         w.empty();
     }
+    if (full_covariance_)
+      for (int i = 0; i < 6; ++i)
+        for (int j = i; j < 6; ++j) w.real_if(r.has_sigma && (j < 3 || r.has_velocity), r.covariance(i, j));
     w.end();
     ++row_count_;
   }
@@ -229,6 +245,7 @@ class CsvSink final : public Component {
   const std::string path_;
   const SourceLoc path_where_;
   const bool include_measurements_;
+  const bool full_covariance_;
   const int precision_;
   std::vector<std::string> sources_;
   bool truth_input_ = true;  // until set_inputs says otherwise, rows wait for truth
@@ -252,17 +269,22 @@ void register_components(Registrar& r) {
   d.summary = "Writes estimates (any number of filters), optional measurements and matching truth of all runs to one CSV file";
   d.doc =
       "Columns: run,time,source,kind,updated,x,y,z,vx,vy,vz,sigma_x..sigma_vz,nis,nees,truth_x..truth_vz,"
-      "quality_range,quality_azimuth,quality_elevation. source is "
+      "quality_range,quality_azimuth,quality_elevation[,cov_x_x,cov_x_y,...,cov_vz_vz]. source is "
       "the upstream node id; kind is estimate or measurement. Truth columns and nees are filled when a truth sample "
       "lies within 1 us of the row's time, nis when the estimate was updated; quality_* hold the per-channel grade "
       "an adapter stamped on the estimate (Estimate::quality; adapt.quality_switch: 0 best, 1 normal, 2 worst), "
-      "empty when there is none; missing values are empty cells. "
+      "empty when there is none; missing values are empty cells. With full_covariance: true, 21 more columns hold "
+      "the upper triangle of the ENU covariance row by row (x y z vx vy vz; m2, m2/s, m2/s2; Cartesian measurement "
+      "rows: their position block). "
       "Measurement rows carry the Cartesian position (spherical ones converted) and, when Cartesian, the sigmas "
       "of the covariance diagonal. Only initialised estimates and valid measurements are written. Rows are in "
       "run order, then arrival order, so the file is identical for a given seed whatever the thread count.";
   d.params = {
       ParamSpec::string("path", "output file relative to --out (default: <node id>.csv)"),
       ParamSpec::boolean("include_measurements", "also write measurement rows").def("false"),
+      ParamSpec::boolean("full_covariance",
+                         "also write the upper triangle of the ENU covariance (cov_x_x ... cov_vz_vz; m2, m2/s, m2/s2)")
+          .def("false"),
       ParamSpec::integer("precision", "significant digits of numbers").def("10").at_least(1).at_most(17),
   };
   d.accepts = ItemKind::Estimate | ItemKind::Truth | mask(ItemKind::Measurement);

@@ -7,7 +7,9 @@
 
 #include <Eigen/Cholesky>
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 
 namespace trackflow {
@@ -28,6 +30,7 @@ class MetricsSink final : public Component {
     truth_.reserve(kReserve);
     estimates_.reserve(kReserve);
     measurements_.reserve(kReserve);
+    ensemble_.annotation_channels = channels_.count();
   }
 
   void set_inputs(const std::vector<InputInfo>& inputs) override {
@@ -54,9 +57,19 @@ class MetricsSink final : public Component {
 
   void on_truth(const Truth& t, int) override { metrics::insert_truth(truth_, t); }
 
+  // Every estimate is kept (uninitialised ones only count towards the per-step fractions).
   void on_estimate(const Estimate& e, int) override {
+    StoredEstimate& s = estimates_.emplace_back();
+    s.time = e.time;
+    s.target = e.target;
+    s.initialised = e.initialised;
+    s.updated = e.updated;
     if (!e.initialised) return;
-    estimates_.push_back({e.time, e.target, e.updated, e.nis, e.enu, e.enu_covariance, e.innovation});
+    s.nis = e.nis;
+    s.enu = e.enu;
+    s.covariance = e.enu_covariance;
+    s.innovation = e.innovation;
+    channels_.read(e, s.annotation);
   }
 
   void on_measurement(const Measurement& m, int) override {
@@ -71,17 +84,29 @@ class MetricsSink final : public Component {
     auto r = std::make_unique<MetricsRunResult>();
     r->had_truth = !truth_.empty();
     r->records.reserve(estimates_.size());
+    r->measurement_records.reserve(measurements_.size());
     const double start = window_start();
     for (const StoredEstimate& e : estimates_) {
+      if (!std::isfinite(e.time)) {
+        if (e.initialised) ++r->non_finite;
+        continue;
+      }
+      EstimateRecord& rec = r->records.emplace_back();
+      rec.key = std::llround(e.time / tolerance_);
+      rec.time = e.time;
+      rec.initialised = e.initialised;
+      rec.updated = e.initialised && e.updated;
+      if (!e.initialised) continue;
+      std::copy(std::begin(e.annotation), std::end(e.annotation), std::begin(rec.annotation));
       if (e.time + tolerance_ < start) {
         ++r->before_window;
         continue;
       }
-      if (!e.enu.allFinite() || !std::isfinite(e.time)) {
+      if (!e.enu.allFinite()) {
         ++r->non_finite;
         continue;
       }
-      r->records.push_back(evaluate(e, *r));
+      evaluate(e, rec, *r);
     }
     measurement_errors(start, *r);
     return r;
@@ -90,18 +115,21 @@ class MetricsSink final : public Component {
   void merge(RunResult& result) override { ensemble_.add(static_cast<MetricsRunResult&>(result)); }
 
   void finish(Summary& summary, const FinishContext&) override {
-    metrics::report(ensemble_, {confidence_, skip_initial_, truth_input_, measurement_input_}, summary);
+    const metrics::ReportOptions opt{confidence_, skip_initial_, truth_input_, measurement_input_};
+    metrics::report(ensemble_, opt, summary);
+    if (ensemble_.runs > 0) summary.series.push_back(metrics::ensemble_series(ensemble_, opt, channels_));
   }
 
  private:
   struct StoredEstimate {
-    double time;
-    std::uint32_t target;
-    bool updated;
-    double nis;
+    double time = 0.0;
+    std::uint32_t target = 0;
+    bool initialised = false, updated = false;
+    double nis = 0.0;
     Vec6 enu;
     Mat6 covariance;
     MeasVec innovation;
+    double annotation[metrics::kMaxAnnotations] = {};
   };
   struct StoredMeasurement {
     double time;
@@ -112,15 +140,15 @@ class MetricsSink final : public Component {
   // estimates (a measurement-only baseline) starts at its first measurement.
   double window_start() const {
     double first = std::numeric_limits<double>::infinity();
-    for (const auto& e : estimates_) first = std::min(first, e.time);
+    for (const auto& e : estimates_)
+      if (e.initialised) first = std::min(first, e.time);
     if (!std::isfinite(first))
       for (const auto& m : measurements_) first = std::min(first, m.time);
     return first + skip_initial_;
   }
 
-  EstimateRecord evaluate(const StoredEstimate& e, MetricsRunResult& r) const {
-    EstimateRecord rec;
-    rec.key = std::llround(e.time / tolerance_);
+  void evaluate(const StoredEstimate& e, EstimateRecord& rec, MetricsRunResult& r) const {
+    rec.scored = true;
     const int m = static_cast<int>(e.innovation.size());
     if (e.updated && m > 0 && std::isfinite(e.nis)) {
       rec.nis_dof = m;
@@ -130,7 +158,7 @@ class MetricsSink final : public Component {
     Vec6 truth;
     if (!metrics::truth_at(metrics::truth_for(truth_, e.target), e.time, tolerance_, truth)) {
       ++r.unmatched;
-      return rec;
+      return;
     }
     rec.matched = true;
     rec.error = e.enu - truth;
@@ -143,7 +171,6 @@ class MetricsSink final : public Component {
       rec.has_nees = std::isfinite(rec.nees) && std::isfinite(rec.nees_position);
     }
     if (!rec.has_nees) ++r.not_positive_definite;
-    return rec;
   }
 
   void measurement_errors(double start, MetricsRunResult& r) const {
@@ -154,8 +181,10 @@ class MetricsSink final : public Component {
       if (m.time + tolerance_ < start) continue;
       Vec6 truth;
       if (usable && metrics::truth_at(span, m.time, tolerance_, truth)) {
-        r.measurement_sq_error += (m.position - truth.head<3>()).squaredNorm();
+        const double sq = (m.position - truth.head<3>()).squaredNorm();
+        r.measurement_sq_error += sq;
         ++r.measurements_matched;
+        r.measurement_records.push_back({std::llround(m.time / tolerance_), m.time, sq});
       } else {
         ++r.measurements_unmatched;
       }
@@ -167,6 +196,7 @@ class MetricsSink final : public Component {
   std::vector<Truth> truth_;
   std::vector<StoredEstimate> estimates_;
   std::vector<StoredMeasurement> measurements_;
+  metrics::AnnotationChannels channels_;
   metrics::Ensemble ensemble_;
 };
 
@@ -183,7 +213,10 @@ void register_components(Registrar& r) {
       "step (n = 6, or 3 for anees_position); anees is its mean over steps, with the per-step band "
       "[chi2inv((1-c)/2, nM), chi2inv((1+c)/2, nM)]/(nM) (Bar-Shalom, Li & Kirubarajan 2001 §5.4.2). ANIS "
       "likewise with the innovation dimension. Without truth (recorded logs) only anis, mean_innovation_<i> "
-      "and counts are reported. Only initialised estimates are scored.";
+      "and counts are reported. Only initialised estimates are scored. Per time step it also publishes the "
+      "ensemble series (`trackflow run --series`, `trackflow report`): position/velocity RMSE, mean error per axis, "
+      "ANEES and ANIS with the band for the runs at that step, measurement RMSE, fractions of runs initialised and "
+      "updated, and the mean of each adapter annotation (quality grades); the series' mean ANEES is anees.";
   d.params = {
       ParamSpec::real("skip_initial", dim::time, "leave out estimates earlier than the first initialised estimate + this (transient)")
           .def("0 s")
