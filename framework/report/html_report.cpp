@@ -74,6 +74,57 @@ td.n { text-align: right; font-variant-numeric: tabular-nums; }
 .note { color: #555; font-size: 0.88em; }
 )css";
 
+// Inline data as columns instead of row objects (about a third of the size): numbers as one
+// array per field, strings run-length coded. The page's script turns them back into rows.
+void compact_data(json& node) {
+  if (node.is_array()) {
+    for (auto& x : node) compact_data(x);
+    return;
+  }
+  if (!node.is_object()) return;
+  auto d = node.find("data");
+  if (d != node.end() && d->is_object() && d->contains("values") && (*d)["values"].is_array()) {
+    const json& rows = (*d)["values"];
+    json cols = json::object();
+    std::vector<std::string> keys;
+    for (const auto& r : rows)
+      for (auto it = r.begin(); it != r.end(); ++it)
+        if (!cols.contains(it.key())) {
+          cols[it.key()] = json::array();
+          keys.push_back(it.key());
+        }
+    bool ok = !rows.empty();
+    for (const auto& k : keys) {
+      json col = json::array();
+      bool text = false;
+      for (const auto& r : rows) {
+        if (!r.contains(k)) {
+          ok = false;
+          break;
+        }
+        text = text || r[k].is_string();
+        col.push_back(r[k]);
+      }
+      if (!ok) break;
+      if (text) {
+        json rle = json::array();
+        for (const auto& v : col) {
+          if (!rle.empty() && rle.back()[0] == v)
+            rle.back()[1] = rle.back()[1].get<long>() + 1;
+          else
+            rle.push_back(json::array({v, 1}));
+        }
+        cols[k] = {{"rle", rle}};
+      } else {
+        cols[k] = std::move(col);
+      }
+    }
+    if (ok) *d = {{"tf_columns", cols}, {"tf_rows", rows.size()}};
+  }
+  for (auto it = node.begin(); it != node.end(); ++it)
+    if (it.key() != "data") compact_data(it.value());
+}
+
 // The page, chart by chart; charts are rendered by the inlined script at load.
 class Page {
  public:
@@ -84,7 +135,9 @@ class Page {
              std::to_string(c.lines) + "\" data-line-points=\"" + std::to_string(c.line_points) + "\" data-areas=\"" +
              std::to_string(c.areas) + "\" data-symbols=\"" + std::to_string(c.symbols) + "\"></div>\n";
     if (!c.caption.empty()) body_ += "<div class=\"caption\">" + esc(c.caption) + "</div>\n";
-    charts_.push_back({{"id", id}, {"spec", c.spec}});
+    json spec = c.spec;
+    compact_data(spec);
+    charts_.push_back({{"id", id}, {"spec", std::move(spec)}});
   }
   std::string finish(const std::string& title) const {
     std::string specs = charts_.dump();
@@ -104,9 +157,35 @@ class Page {
     out += R"js(// Renders every chart as SVG; data-rendered / data-failed on <body> say when all are done.
 (function () {
   var charts = JSON.parse(document.getElementById('tf-charts').textContent);
+  // Inline data come as columns ({tf_columns: {x: [...], s: {rle: [[v, n], ...]}}, tf_rows: n}).
+  function rows(data) {
+    var cols = {}, n = data.tf_rows, out = new Array(n);
+    Object.keys(data.tf_columns).forEach(function (k) {
+      var c = data.tf_columns[k];
+      if (c && c.rle) {
+        var full = [];
+        c.rle.forEach(function (r) { for (var i = 0; i < r[1]; i++) full.push(r[0]); });
+        c = full;
+      }
+      cols[k] = c;
+    });
+    for (var i = 0; i < n; i++) {
+      var row = {};
+      for (var k in cols) row[k] = cols[k][i];
+      out[i] = row;
+    }
+    return out;
+  }
+  function expand(node) {
+    if (Array.isArray(node)) { node.forEach(expand); return; }
+    if (!node || typeof node !== 'object') return;
+    if (node.data && node.data.tf_columns) node.data = { values: rows(node.data) };
+    Object.keys(node).forEach(function (k) { if (k !== 'data') expand(node[k]); });
+  }
   var jobs = charts.map(function (c) {
     var el = document.getElementById(c.id);
     try {
+      expand(c.spec);
       var spec = vegaLite.compile(c.spec).spec;
       return new vega.View(vega.parse(spec), { renderer: 'svg', container: el, hover: true }).runAsync()
         .catch(function (e) { el.textContent = 'plot failed: ' + e; throw e; });
@@ -382,6 +461,26 @@ void track_section(Page& page, const host::Graph& g, const host::Outcome& out, c
   page.chart(track_chart("altitude against time", "time [s]", "up z [m]", alt_paths, alt_points, false));
 }
 
+// Series of per-interval RMSE (sink.interval_rmse): the filter against the measurements.
+void interval_section(Page& page, const host::Graph& g, const host::Outcome& out) {
+  bool header = false;
+  for (size_t i = 0; i < out.nodes.size() && i < g.nodes.size(); ++i)
+    for (const auto& s : out.nodes[i].summary.series) {
+      if (s.name != "intervals" || s.column("filter_rmse") < 0) continue;
+      if (!header) {
+        page.html("<h2>RMSE per interval</h2>\n");
+        header = true;
+      }
+      std::vector<Line> lines = {column_line(s, "filter_rmse", "filter", "interval_start"),
+                                 column_line(s, "measurement_rmse", "measurements", "interval_start")};
+      Chart c = line_chart("position RMSE per interval - " + out.nodes[i].id, "interval start [s]", "position RMSE [m]",
+                           lines, true);
+      c.spec["mark"]["point"] = true;
+      c.symbols = c.line_points;  // a symbol on every point
+      page.chart(c);
+    }
+}
+
 void files_section(Page& page, const std::vector<std::string>& files) {
   if (files.empty()) return;
   page.html("<h2>Files</h2>\n<p class=\"note\">The numbers behind the plots, at full precision and every step "
@@ -405,6 +504,7 @@ std::string render_run_report(const RunReport& r) {
   consistency_section(page, scored);
   if (!r.track_node.empty()) track_section(page, g, out, r.track_node, r.track_run);
   annotation_section(page, scored);
+  interval_section(page, g, out);
   files_section(page, r.files);
   return page.finish(g.config.name + " - trackflow report");
 }
@@ -453,6 +553,7 @@ std::string render_sweep_report(const SweepReport& r) {
       Chart c = line_chart(m.name + " against " + ax.name, xt, yt, lines);
       if (log_x) c.spec["encoding"]["x"]["scale"] = {{"type", "log"}};
       c.spec["mark"]["point"] = true;
+      c.symbols = c.line_points;  // a symbol on every point
       c.caption = log_x ? "log scale on x" : "";
       page.chart(c);
     }

@@ -1,6 +1,6 @@
 // Purpose: injected by tests/report/browser.sh into a copy of a report: once every chart has
 // rendered, counts what the browser actually drew in each chart's SVG (line paths and their
-// points, band areas, symbols) and appends one line per chart to <pre id="tf-count">.
+// points, band areas, symbols) and appends one line per chart to a pre element, id tf-count.
 (function () {
   function count() {
     if (!document.body.hasAttribute('data-rendered')) { setTimeout(count, 50); return; }
