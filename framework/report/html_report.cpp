@@ -130,6 +130,11 @@ class Page {
  public:
   void html(const std::string& s) { body_ += s; }
   void chart(const Chart& c) {
+    // A plot with nothing to draw (e.g. errors of a pipeline without truth) becomes a note.
+    if (c.lines + c.areas + c.symbols == 0) {
+      body_ += "<p class=\"note\">" + esc(c.title) + ": no data to plot.</p>\n";
+      return;
+    }
     const std::string id = "chart-" + std::to_string(charts_.size());
     body_ += "<div class=\"chart\" id=\"" + id + "\" data-title=\"" + esc(c.title) + "\" data-lines=\"" +
              std::to_string(c.lines) + "\" data-line-points=\"" + std::to_string(c.line_points) + "\" data-areas=\"" +
