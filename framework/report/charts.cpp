@@ -179,10 +179,18 @@ Chart track_chart(const std::string& title, const std::string& x_title, const st
     }
   }
   json domain = labels(all);
+  // Truth in black, measurements in pale colours, estimates in strong ones.
+  const char* pale[] = {"#9ecae1", "#c7c7c7", "#fdd0a2", "#c7e9c0"};
+  const char* strong[] = {"#d62728", "#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2"};
+  json range = json::array();
+  size_t np = 0, ns = 0;
+  for (size_t i = 0; i < points.size(); ++i) range.push_back(pale[np++ % 4]);
+  for (const auto& l : paths)
+    range.push_back(l.label == "truth" || l.label.find("(truth)") != std::string::npos ? "#000000" : strong[ns++ % 7]);
   c.spec = base_spec(title);
   c.spec["width"] = width;
   c.spec["height"] = height;
-  json color = {{"field", "s"}, {"type", "nominal"}, {"title", nullptr}, {"scale", {{"domain", domain}}}};
+  json color = {{"field", "s"}, {"type", "nominal"}, {"title", nullptr}, {"scale", {{"domain", domain}, {"range", range}}}};
   c.spec["layer"] = json::array(
       {{{"data", {{"values", point_values}}},
         {"mark", {{"type", "point"}, {"filled", true}, {"size", 6}, {"opacity", 0.5}, {"clip", true}}},

@@ -448,7 +448,9 @@ void track_section(Page& page, const host::Graph& g, const host::Outcome& out, c
     const auto colon = s.name.find(':');
     const std::string kind = s.name.substr(0, colon), node = s.name.substr(colon + 1);
     if (kind == "measurement" && !fed.empty() && !fed.count(node)) continue;
-    const std::string label = kind == "truth" ? node + " (truth)" : kind == "measurement" ? node + " (measurements)" : node;
+    const std::string label = kind == "truth"         ? (node == "truth" ? node : node + " (truth)")
+                              : kind == "measurement" ? node + " (measurements)"
+                                                      : node;
     Line ground = column_line(s, "y", label, "x");
     Line alt = column_line(s, "z", label);
     if (kind == "measurement") {

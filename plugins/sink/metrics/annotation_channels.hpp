@@ -25,9 +25,11 @@ class AnnotationChannels {
   std::string unit(int) const { return {}; }  // grades are pure numbers (0 best, 1 normal, 2 worst)
 
   // values[0..count()): the estimate's value of each channel, NaN where it carries none.
-  void read(const Estimate& e, double* values) const {
-    for (int c = 0; c < count(); ++c)
-      values[c] = e.quality[c] >= 0 ? static_cast<double>(e.quality[c]) : std::numeric_limits<double>::quiet_NaN();
+  // Single precision: kept for every estimate of a run in flight, and grades or adapted
+  // sigmas need no more.
+  void read(const Estimate& e, float* values) const {
+    for (int c = 0; c < count() && c < kMaxAnnotations; ++c)
+      values[c] = e.quality[c] >= 0 ? static_cast<float>(e.quality[c]) : std::numeric_limits<float>::quiet_NaN();
   }
 
  private:
@@ -39,10 +41,10 @@ struct AnnotationSums {
   double sum[kMaxAnnotations] = {};
   std::uint32_t count[kMaxAnnotations] = {};
 
-  void add(const double* values, int n) {
+  void add(const float* values, int n) {
     for (int c = 0; c < n && c < kMaxAnnotations; ++c)
       if (std::isfinite(values[c])) {
-        sum[c] += values[c];
+        sum[c] += static_cast<double>(values[c]);
         ++count[c];
       }
   }

@@ -20,7 +20,7 @@ struct EstimateRecord {
   double time = 0.0;
   bool initialised = false, updated = false;
   bool scored = false;      // initialised, finite and after first estimate + skip_initial
-  double annotation[kMaxAnnotations] = {};  // AnnotationChannels::read, NaN: absent
+  float annotation[kMaxAnnotations] = {};  // AnnotationChannels::read, NaN: absent (float: kept per run)
   bool matched = false;     // a truth state exists at this time
   bool has_nees = false;    // matched and the covariance is positive definite
   Vec6 error = Vec6::Zero();  // estimate - truth, ENU [position; velocity]

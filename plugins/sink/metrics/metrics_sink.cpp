@@ -23,14 +23,17 @@ using metrics::MetricsRunResult;
 class MetricsSink final : public Component {
  public:
   explicit MetricsSink(const Params& p)
-      : skip_initial_(p.real("skip_initial")), confidence_(p.real("confidence")), tolerance_(p.real("time_tolerance")) {
+      : skip_initial_(p.real("skip_initial")),
+        confidence_(p.real("confidence")),
+        tolerance_(p.real("time_tolerance")),
+        series_(p.boolean("series")) {
     if (!(confidence_ > 0.0 && confidence_ < 1.0))
       throw p.error("confidence", "must lie strictly between 0 and 1 (e.g. 0.95)");
     constexpr size_t kReserve = 4096;
     truth_.reserve(kReserve);
     estimates_.reserve(kReserve);
     measurements_.reserve(kReserve);
-    ensemble_.annotation_channels = channels_.count();
+    ensemble_.annotation_channels = series_ ? channels_.count() : 0;
   }
 
   void set_inputs(const std::vector<InputInfo>& inputs) override {
@@ -59,6 +62,7 @@ class MetricsSink final : public Component {
 
   // Every estimate is kept (uninitialised ones only count towards the per-step fractions).
   void on_estimate(const Estimate& e, int) override {
+    if (!e.initialised && !series_) return;
     StoredEstimate& s = estimates_.emplace_back();
     s.time = e.time;
     s.target = e.target;
@@ -69,7 +73,7 @@ class MetricsSink final : public Component {
     s.enu = e.enu;
     s.covariance = e.enu_covariance;
     s.innovation = e.innovation;
-    channels_.read(e, s.annotation);
+    if (series_) channels_.read(e, s.annotation);
   }
 
   void on_measurement(const Measurement& m, int) override {
@@ -117,7 +121,7 @@ class MetricsSink final : public Component {
   void finish(Summary& summary, const FinishContext&) override {
     const metrics::ReportOptions opt{confidence_, skip_initial_, truth_input_, measurement_input_};
     metrics::report(ensemble_, opt, summary);
-    if (ensemble_.runs > 0) summary.series.push_back(metrics::ensemble_series(ensemble_, opt, channels_));
+    if (series_ && ensemble_.runs > 0) summary.series.push_back(metrics::ensemble_series(ensemble_, opt, channels_));
   }
 
  private:
@@ -129,7 +133,7 @@ class MetricsSink final : public Component {
     Vec6 enu;
     Mat6 covariance;
     MeasVec innovation;
-    double annotation[metrics::kMaxAnnotations] = {};
+    float annotation[metrics::kMaxAnnotations] = {};
   };
   struct StoredMeasurement {
     double time;
@@ -184,7 +188,7 @@ class MetricsSink final : public Component {
         const double sq = (m.position - truth.head<3>()).squaredNorm();
         r.measurement_sq_error += sq;
         ++r.measurements_matched;
-        r.measurement_records.push_back({std::llround(m.time / tolerance_), m.time, sq});
+        if (series_) r.measurement_records.push_back({std::llround(m.time / tolerance_), m.time, sq});
       } else {
         ++r.measurements_unmatched;
       }
@@ -192,6 +196,7 @@ class MetricsSink final : public Component {
   }
 
   const double skip_initial_, confidence_, tolerance_;
+  const bool series_;
   bool truth_input_ = false, measurement_input_ = false;
   std::vector<Truth> truth_;
   std::vector<StoredEstimate> estimates_;
@@ -228,6 +233,10 @@ void register_components(Registrar& r) {
       ParamSpec::real("time_tolerance", dim::time, "items closer in time than this are the same time step")
           .def("1 us")
           .positive(),
+      ParamSpec::boolean("series",
+                         "publish the per-step ensemble series (measurement RMSE, fractions of runs, annotations per "
+                         "step); false keeps only what the summary needs")
+          .def("true"),
   };
   d.accepts = ItemKind::Estimate | ItemKind::Truth | mask(ItemKind::Measurement);
   d.min_inputs = 1;
