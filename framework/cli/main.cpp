@@ -1,5 +1,6 @@
-// Purpose: the `trackflow` command: run, validate, plugins, describe.
+// Purpose: the `trackflow` command: run, report, validate, plugins, describe.
 #include "cli_common.hpp"
+#include "report_command.hpp"
 
 #include <trackflow/host/engine.hpp>
 #include <trackflow/host/report.hpp>
@@ -8,6 +9,7 @@
 #include <trackflow/version.hpp>
 
 #include <boost/program_options.hpp>
+#include <nlohmann/json.hpp>
 
 #include <unistd.h>
 
@@ -32,6 +34,8 @@ Usage: trackflow <command> [options]
 Commands:
   run FILE        run a pipeline once or as a Monte Carlo ensemble, print a summary,
                   check its `expect:` block
+  report FILE     run it and write one self-contained HTML report with plots (and the
+                  per-step series as CSV): `run FILE --report FILE.html --series` in one word
   validate FILE   check a pipeline without running it (types, parameters, units, wiring)
   plugins         list the plugin files found and the component types they provide
   describe TYPE   show a component type's parameters (name, type, unit, default, doc)
@@ -51,7 +55,10 @@ struct Loaded {
   Graph graph;
 };
 
-Loaded load_pipeline(const std::string& file, const std::vector<std::string>& sets, const Common& c) {
+// `track_run` >= 0: also record that run's items for the report (a sink.track node is added;
+// its id goes to `track_node`).
+Loaded load_pipeline(const std::string& file, const std::vector<std::string>& sets, const Common& c,
+                     long long track_run = -1, std::string* track_node = nullptr) {
   std::vector<Override> overrides;
   for (const auto& s : sets) overrides.push_back(parse_override(s));
   Value root = load_yaml_file(file);
@@ -59,18 +66,21 @@ Loaded load_pipeline(const std::string& file, const std::vector<std::string>& se
   l.cfg = parse_pipeline(root, file, overrides);
   l.reg = load_plugins(c, l.cfg.plugin_paths);
   warn_problems(l.reg);
+  if (track_run >= 0 && track_node && l.reg.find("sink.track"))
+    *track_node = add_track_recorder(l.cfg, l.reg, static_cast<std::uint64_t>(track_run));
   l.graph = build_graph(l.cfg, l.reg);
   return l;
 }
 
-int cmd_run(int argc, char** argv) {
+// `run` and `report` (= run with --report <out>/report.html --series).
+int cmd_run(int argc, char** argv, bool report_mode = false) {
   Common c;
-  std::string file, out_dir, metrics_json;
+  std::string file, out_dir, metrics_json, report_html;
   std::vector<std::string> sets;
-  std::uint64_t runs = 0, seed = 0;
+  std::uint64_t runs = 0, seed = 0, track_run = 0;
   unsigned threads = 1;
-  bool quiet = false, no_progress = false;
-  po::options_description o("trackflow run options");
+  bool quiet = false, no_progress = false, series = false;
+  po::options_description o(report_mode ? "trackflow report options" : "trackflow run options");
   o.add_options()("help,h", "show this help")("file", po::value(&file), "pipeline YAML file")(
       "runs,n", po::value(&runs), "Monte Carlo runs (default: the pipeline's `runs:`)")(
       "threads,j", po::value(&threads)->default_value(1),
@@ -79,16 +89,30 @@ int cmd_run(int argc, char** argv) {
       "set", po::value(&sets)->composing(),
       "override a parameter: --set kf.q=4 --set radar.sigma_range=\"20 m\" (repeatable)")(
       "out,o", po::value(&out_dir), "folder for files written by sinks (default: out/<pipeline name>)")(
-      "metrics-json", po::value(&metrics_json), "write {sink id: {metric: value}} to this file")(
+      "metrics-json", po::value(&metrics_json),
+      "write {node id: {metric: {value, unit[, band_lo, band_hi, confidence]}}} to this file")(
+      "series", po::bool_switch(&series),
+      "write every node's per-step series (e.g. sink.metrics' RMSE, ANEES, ANIS per time step) as CSV "
+      "into the --out folder")(
+      "report", po::value(&report_html),
+      report_mode ? "the HTML file (default: <out>/report.html)" : "also write the HTML report with plots to this file")(
+      "track-run", po::value(&track_run)->default_value(0), "the run whose track the report draws")(
       "quiet,q", po::bool_switch(&quiet), "print only expect failures and errors")(
       "no-progress", po::bool_switch(&no_progress), "no progress bar even on a terminal");
   o.add(common_options(c));
   po::positional_options_description pos;
   pos.add("file", 1);
   po::variables_map vm;
-  if (!parse(argc, argv, o, pos, vm, "Usage: trackflow run FILE [options]")) return kOk;
-  if (file.empty()) throw po::error("run needs a pipeline FILE");
-  Loaded l = load_pipeline(file, sets, c);
+  if (!parse(argc, argv, o, pos, vm,
+             report_mode ? "Usage: trackflow report FILE [options]\n\nRuns FILE like `trackflow run` and writes one "
+                           "self-contained HTML report (plots inlined, opens offline) and the per-step series as CSV "
+                           "into the --out folder."
+                         : "Usage: trackflow run FILE [options]"))
+    return kOk;
+  if (file.empty()) throw po::error(std::string(report_mode ? "report" : "run") + " needs a pipeline FILE");
+  const bool want_report = report_mode || !report_html.empty();
+  std::string track_node;
+  Loaded l = load_pipeline(file, sets, c, want_report ? static_cast<long long>(track_run) : -1, &track_node);
   RunOptions ro;
   ro.runs = vm.count("runs") ? runs : l.graph.config.runs;
   if (ro.runs == 0) throw ConfigError("--runs must be at least 1");
@@ -105,12 +129,24 @@ int cmd_run(int argc, char** argv) {
                 << total << " runs" << (done == total ? "\n" : "") << std::flush;
     };
   }
+  if (want_report && track_run >= ro.runs)
+    throw ConfigError("--track-run " + std::to_string(track_run) + ": there are only " + std::to_string(ro.runs) +
+                      " runs (0 to " + std::to_string(ro.runs - 1) + ")");
   Outcome out = run_graph(l.graph, l.reg, ro);
   auto results = check_expects(l.graph, out);
   if (!metrics_json.empty()) write_metrics_json(metrics_json, out);
+  ReportRequest req;
+  if (series || report_mode) req.series_dir = ro.output_dir;
+  if (want_report)
+    req.html = report_html.empty() ? (std::filesystem::path(ro.output_dir) / "report.html").string() : report_html;
+  req.track_node = track_node;
+  req.track_run = track_run;
+  req.command = command_line(argc, argv);
+  const auto written = write_report_outputs(req, l.graph, out, results, static_cast<unsigned>(std::min<std::uint64_t>(ro.threads, ro.runs)));
   const bool all_pass = std::all_of(results.begin(), results.end(), [](const ExpectResult& r) { return r.passed; });
   if (!quiet) {
     print_summary(std::cout, l.graph, out, std::min<std::uint64_t>(ro.threads, ro.runs), results);
+    for (const auto& f : written) std::cout << "wrote " << f << "\n";
   } else {
     for (const auto& r : results)
       if (!r.passed) std::cout << "FAIL " << r.text << " (" << r.expect.loc.str() << ")\n";
@@ -148,33 +184,30 @@ int cmd_plugins(int argc, char** argv) {
   if (!parse(argc, argv, o, pos, vm, "Usage: trackflow plugins [--json]\n\nLists plugin files found and the component types each provides; exit 2 if any file failed to load.")) return kOk;
   PluginRegistry reg = load_plugins(c, {});
   if (json) {
-    std::cout << "{\n  \"searched\": [";
-    for (size_t i = 0; i < reg.searched().size(); ++i)
-      std::cout << (i ? ", " : "") << "\"" << json_escape(reg.searched()[i]) << "\"";
-    std::cout << "],\n  \"types\": [";
-    bool first = true;
-    for (const auto& t : reg.types()) {
-      std::cout << (first ? "\n" : ",\n") << "    {\"type\": \"" << json_escape(t.decl.type) << "\", \"kind\": \""
-                << to_string(t.decl.kind) << "\", \"file\": \"" << json_escape(t.file) << "\", \"summary\": \""
-                << json_escape(t.decl.summary) << "\"}";
-      first = false;
-    }
-    std::cout << "\n  ],\n  \"problems\": [";
-    first = true;
-    for (const auto& p : reg.problems()) {
-      std::cout << (first ? "\n" : ",\n") << "    {\"file\": \"" << json_escape(p.file) << "\", \"stage\": \""
-                << p.stage << "\", \"message\": \"" << json_escape(p.message) << "\"}";
-      first = false;
-    }
-    std::cout << "\n  ]\n}\n";
+    nlohmann::ordered_json j;
+    j["searched"] = reg.searched();
+    j["types"] = nlohmann::ordered_json::array();
+    for (const auto& t : reg.types())
+      j["types"].push_back(
+          {{"type", t.decl.type}, {"kind", to_string(t.decl.kind)}, {"file", t.file}, {"summary", t.decl.summary}});
+    j["problems"] = nlohmann::ordered_json::array();
+    for (const auto& p : reg.problems())
+      j["problems"].push_back({{"file", p.file}, {"stage", p.stage}, {"message", p.message}});
+    std::cout << j.dump(2) << "\n";
   } else {
     std::cout << "searched: " << join(reg.searched()) << "\n";
+    // Columns as wide as their longest entry (plus two spaces), so long names never run into the kind.
+    size_t type_w = 4, kind_w = 4;
+    for (const auto& t : reg.types()) {
+      type_w = std::max(type_w, t.decl.type.size());
+      kind_w = std::max(kind_w, std::string(to_string(t.decl.kind)).size());
+    }
     for (const auto& p : reg.plugins()) {
       std::cout << "\n" << p.file << "\n";
       for (const auto& type : p.types) {
         const auto* t = reg.find(type);
-        std::cout << "  " << std::left << std::setw(24) << type << std::setw(11) << to_string(t->decl.kind)
-                  << t->decl.summary << "\n";
+        std::cout << "  " << std::left << std::setw(static_cast<int>(type_w + 2)) << type
+                  << std::setw(static_cast<int>(kind_w + 2)) << to_string(t->decl.kind) << t->decl.summary << "\n";
       }
     }
     for (const auto& p : reg.problems()) std::cout << "\nnot loaded: " << p.str() << "\n";
@@ -189,25 +222,44 @@ std::string kinds_text(ItemMask m) {
   return k.empty() ? "-" : join(k, ", ");
 }
 
-void describe_params(std::ostream& os, const std::vector<ParamSpec>& ps, const std::string& indent, bool md) {
+std::string default_text(const ParamSpec& p) {
+  return p.required ? "required" : p.default_text.empty() ? "optional" : "default " + p.default_text;
+}
+
+void describe_params_md(std::ostream& os, const std::vector<ParamSpec>& ps) {
   for (const auto& p : ps) {
-    std::string def = p.required ? "required" : p.default_text.empty() ? "optional" : "default " + p.default_text;
-    if (md) {
-      os << indent << "| `" << p.name << "` | " << describe_type(p) << " | " << def << " | " << p.doc << " |\n";
-    } else {
-      os << indent << std::left << std::setw(22) << p.name << " " << std::setw(26) << describe_type(p) << " "
-         << std::setw(18) << def << " " << p.doc << "\n";
-    }
+    os << "| `" << p.name << "` | " << describe_type(p) << " | " << default_text(p) << " | " << p.doc << " |\n";
     if (p.type == ParamType::Records) {
-      if (md) {
-        os << "\nFields of each `" << p.name << "` entry:\n\n| field | type | default | doc |\n|---|---|---|---|\n";
-        describe_params(os, p.fields, "", true);
-        os << "\n";
-      } else {
-        describe_params(os, p.fields, indent + "    ", false);
-      }
+      os << "\nFields of each `" << p.name << "` entry:\n\n| field | type | default | doc |\n|---|---|---|---|\n";
+      describe_params_md(os, p.fields);
+      os << "\n";
     }
   }
+}
+
+// Text table: record fields indented under their list; every column as wide as its widest
+// cell (over the nested fields too), so long names and `choice {...}` lists never misalign.
+void describe_params_text(std::ostream& os, const std::vector<ParamSpec>& ps, const std::string& indent) {
+  struct Row {
+    std::string name, type, def, doc;
+  };
+  std::vector<Row> rows;
+  auto collect = [&](auto& self, const std::vector<ParamSpec>& list, const std::string& in) -> void {
+    for (const auto& p : list) {
+      rows.push_back({in + p.name, describe_type(p), default_text(p), p.doc});
+      if (p.type == ParamType::Records) self(self, p.fields, in + "    ");
+    }
+  };
+  collect(collect, ps, "");
+  size_t wn = 0, wt = 0, wd = 0;
+  for (const auto& r : rows) {
+    wn = std::max(wn, r.name.size());
+    wt = std::max(wt, r.type.size());
+    wd = std::max(wd, r.def.size());
+  }
+  for (const auto& r : rows)
+    os << indent << std::left << std::setw(static_cast<int>(wn + 2)) << r.name << std::setw(static_cast<int>(wt + 2))
+       << r.type << std::setw(static_cast<int>(wd + 2)) << r.def << r.doc << "\n";
 }
 
 void describe(std::ostream& os, const RegisteredType& t, bool md) {
@@ -220,7 +272,7 @@ void describe(std::ostream& os, const RegisteredType& t, bool md) {
        << ".\n\n";
     if (!d.params.empty()) {
       os << "| parameter | type [unit] | default | doc |\n|---|---|---|---|\n";
-      describe_params(os, d.params, "", true);
+      describe_params_md(os, d.params);
     }
     os << "\n";
     return;
@@ -230,7 +282,7 @@ void describe(std::ostream& os, const RegisteredType& t, bool md) {
   os << "\ninputs:  " << kinds_text(d.accepts) << " (" << d.min_inputs << " to "
      << (d.max_inputs < 0 ? std::string("any") : std::to_string(d.max_inputs)) << ")\noutputs: " << kinds_text(d.produces)
      << "\n\nparameters (bare numbers are SI: m, s, rad; or write a unit: 3 mrad, 1.5 km, 40 Hz):\n";
-  describe_params(os, d.params, "  ", false);
+  describe_params_text(os, d.params, "  ");
 }
 
 int cmd_describe(int argc, char** argv) {
@@ -275,12 +327,13 @@ int main(int argc, char** argv) {
   }
   try {
     if (cmd == "run") return cmd_run(argc - 1, argv + 1);
+    if (cmd == "report") return cmd_run(argc - 1, argv + 1, true);
     if (cmd == "validate") return cmd_validate(argc - 1, argv + 1);
     if (cmd == "plugins") return cmd_plugins(argc - 1, argv + 1);
     if (cmd == "describe") return cmd_describe(argc - 1, argv + 1);
     if (cmd == "sweep") return cmd_sweep(argc - 1, argv + 1);
     std::cerr << "trackflow: unknown command '" << cmd << "'"
-              << did_you_mean(cmd, {"run", "validate", "plugins", "describe", "sweep"}) << "\n\n" << kTopHelp;
+              << did_you_mean(cmd, {"run", "report", "validate", "plugins", "describe", "sweep"}) << "\n\n" << kTopHelp;
     return kBadInput;
   } catch (const ConfigError& e) {
     std::cerr << "trackflow: error: " << e.message() << "\n";

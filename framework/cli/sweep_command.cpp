@@ -1,10 +1,14 @@
 // Purpose: `trackflow sweep`: runs a pipeline at every point of a parameter grid and tabulates chosen metrics.
 #include "cli_common.hpp"
+#include "csv_text.hpp"
+#include "html_report.hpp"
+#include "report_command.hpp"
 
 #include <trackflow/host/engine.hpp>
 #include <trackflow/host/report.hpp>
 #include <trackflow/host/suggest.hpp>
 #include <trackflow/host/sweep.hpp>
+#include <trackflow/units.hpp>
 
 #include <unistd.h>
 
@@ -30,6 +34,9 @@ Runs FILE once per point of the grid (the Cartesian product of the --param lists
 same seed (common random numbers), so differences between rows come from the parameters.
 Grid points run in parallel on --threads workers (each point's runs on one thread); the table
 does not depend on the thread count. `expect:` checks are not applied in a sweep.
+The --csv file holds numbers in SI with the unit in the column header (radar.sigma_range_m,
+score.position_rmse_m); --report writes an HTML page with each metric against the first
+numeric axis.
 
 Example (paper 000 Table 10):
   trackflow sweep pipelines/quickstart.yaml --param kf.q=0.01,0.1,1,10,100 --runs 50 \
@@ -47,11 +54,40 @@ std::string cell(double v) {
   return buf;
 }
 
+// An axis' values in SI when its parameter is a real or an integer ("5 m" -> 5, "20 km" ->
+// 20000), with the SI unit; NaN for values that are not one number (lists, choices, text).
+report::SweepAxisView axis_view(const host::SweepAxis& a, const host::Graph& g,
+                                const std::vector<std::vector<host::Override>>& grid, size_t axis) {
+  report::SweepAxisView v;
+  v.name = a.node + "." + a.param;
+  const ParamSpec* spec = nullptr;
+  for (const auto& n : g.nodes)
+    if (n.config.id == a.node)
+      for (const auto& p : n.type->decl.params)
+        if (p.name == a.param) spec = &p;
+  const bool numeric = spec && (spec->type == ParamType::Real || spec->type == ParamType::Integer);
+  if (numeric && spec->type == ParamType::Real && !spec->dimension.dimensionless()) v.unit = spec->dimension.str();
+  for (const auto& point : grid) {
+    const std::string& text = point[axis].value;
+    v.text.push_back(text);
+    double x = NAN;
+    if (numeric) {
+      try {
+        x = parse_quantity(text).value;
+      } catch (const std::exception&) {
+        x = NAN;  // already refused by validation if it mattered; keep the text
+      }
+    }
+    v.value.push_back(x);
+  }
+  return v;
+}
+
 }  // namespace
 
 int cmd_sweep(int argc, char** argv) {
   Common c;
-  std::string file, csv_path;
+  std::string file, csv_path, report_path;
   std::vector<std::string> params, sets, metric_names;
   std::uint64_t runs = 0, seed = 0;
   unsigned threads = 1;
@@ -64,7 +100,8 @@ int cmd_sweep(int argc, char** argv) {
       "threads,j", po::value(&threads)->default_value(1), "grid points run in parallel")(
       "seed", po::value(&seed), "base seed (default: the pipeline's)")(
       "set", po::value(&sets)->composing(), "fixed override for every point, as for run")(
-      "csv", po::value(&csv_path), "also write the table to this CSV file")(
+      "csv", po::value(&csv_path), "also write the table to this CSV file (SI numbers, units in the header)")(
+      "report", po::value(&report_path), "also write an HTML report: each metric against the first numeric axis")(
       "out,o", po::value<std::string>(), "folder for files written by sinks (default: out/<name>/sweep-<i>)");
   o.add(common_options(c));
   po::positional_options_description pos;
@@ -177,21 +214,42 @@ int cmd_sweep(int argc, char** argv) {
     for (size_t k = 0; k < r.size(); ++k) std::cout << (k ? "  " : "") << std::setw(static_cast<int>(width[k])) << r[k];
     std::cout << "\n";
   }
+  std::vector<report::SweepAxisView> axis_views;
+  for (size_t a = 0; a < axes.size(); ++a) axis_views.push_back(axis_view(axes[a], graphs.front(), grid, a));
+  std::vector<report::SweepMetricView> metric_views;
+  for (const auto& m : metrics) {
+    report::SweepMetricView v{m.node + "." + m.metric, outcomes.front().find(m.node)->summary.find(m.metric)->unit, {}};
+    for (const auto& o : outcomes) v.value.push_back(o.find(m.node)->summary.find(m.metric)->value);
+    metric_views.push_back(std::move(v));
+  }
   if (!csv_path.empty()) {
-    const auto parent = std::filesystem::path(csv_path).parent_path();
-    if (!parent.empty()) std::filesystem::create_directories(parent);
-    std::ofstream f(csv_path);
-    auto quote = [](const std::string& s) {
-      return s.find_first_of(",\"") == std::string::npos ? s : "\"" + std::string(s) + "\"";
-    };
-    for (size_t k = 0; k < header.size(); ++k) f << (k ? "," : "") << quote(header[k]);
-    f << "\n";
-    for (const auto& r : rows) {
-      for (size_t k = 0; k < r.size(); ++k) f << (k ? "," : "") << quote(r[k]);
-      f << "\n";
+    // Numbers in SI, units in the header, text (lists, choices) quoted per RFC 4180.
+    std::string text;
+    std::vector<std::string> cols;
+    for (const auto& a : axis_views) cols.push_back(report::column_header(a.name, a.unit));
+    for (const auto& m : metric_views) cols.push_back(report::column_header(m.name, m.unit));
+    for (size_t k = 0; k < cols.size(); ++k) text += (k ? "," : "") + report::csv_field(cols[k]);
+    text += "\n";
+    for (size_t i = 0; i < grid.size(); ++i) {
+      size_t k = 0;
+      for (const auto& a : axis_views)
+        text += (k++ ? "," : "") + (std::isfinite(a.value[i]) ? report::csv_number(a.value[i]) : report::csv_field(a.text[i]));
+      for (const auto& m : metric_views) text += (k++ ? "," : "") + report::csv_number(m.value[i]);
+      text += "\n";
     }
-    if (!f) throw ConfigError("cannot write '" + csv_path + "'");
+    report::write_text_file(csv_path, text);
     std::cout << "wrote " << csv_path << "\n";
+  }
+  if (!report_path.empty()) {
+    report::SweepReport r;
+    r.graph = &graphs.front();
+    r.runs = outcomes.front().runs;
+    r.command = command_line(argc, argv);
+    r.axes = axis_views;
+    r.metrics = metric_views;
+    if (!csv_path.empty()) r.files.push_back(csv_path);
+    report::write_text_file(report_path, report::render_sweep_report(r));
+    std::cout << "wrote " << report_path << "\n";
   }
   return kOk;
 }

@@ -2,6 +2,8 @@
 #include <trackflow/host/report.hpp>
 #include <trackflow/host/suggest.hpp>
 
+#include <nlohmann/json.hpp>
+
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -29,30 +31,6 @@ std::string fmt(double v) {
 }
 
 }  // namespace
-
-std::string json_escape(const std::string& s) {
-  std::string o;
-  for (char c : s) {
-    if (c == '"' || c == '\\') {
-      o += '\\';
-      o += c;
-    } else if (static_cast<unsigned char>(c) < 0x20) {
-      char buf[8];
-      std::snprintf(buf, sizeof buf, "\\u%04x", c);
-      o += buf;
-    } else {
-      o += c;
-    }
-  }
-  return o;
-}
-
-std::string json_number(double v) {
-  if (!std::isfinite(v)) return "null";
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.17g", v);
-  return buf;
-}
 
 namespace {
 
@@ -178,34 +156,31 @@ void print_summary(std::ostream& os, const Graph& g, const Outcome& out, unsigne
   }
 }
 
+// Each metric as an object with its unit (and band), written by nlohmann::json: NaN or
+// infinity become null, strings are escaped by the library.
 void write_metrics_json(const std::string& path, const Outcome& out) {
   const std::filesystem::path parent = std::filesystem::path(path).parent_path();
   std::error_code ec;
   if (!parent.empty()) std::filesystem::create_directories(parent, ec);
-  std::ofstream f(path);
-  if (!f) throw ConfigError("cannot write metrics JSON '" + path + "'");
-  f << "{";
-  bool first_node = true;
+  nlohmann::ordered_json j = nlohmann::ordered_json::object();
   for (const auto& n : out.nodes) {
     if (n.summary.metrics.empty() && n.skips == 0) continue;
-    f << (first_node ? "\n" : ",\n") << "  \"" << json_escape(n.id) << "\": {";
-    first_node = false;
-    bool first = true;
-    auto put = [&](const std::string& k, double v) {
-      f << (first ? "\n" : ",\n") << "    \"" << json_escape(k) << "\": " << json_number(v);
-      first = false;
-    };
+    nlohmann::ordered_json node = nlohmann::ordered_json::object();
     for (const auto& m : n.summary.metrics) {
-      put(m.name, m.value);
+      nlohmann::ordered_json v = {{"value", m.value}, {"unit", m.unit}};
       if (m.has_band) {
-        put(m.name + "_band_lo", m.band_lo);
-        put(m.name + "_band_hi", m.band_hi);
+        v["band_lo"] = m.band_lo;
+        v["band_hi"] = m.band_hi;
+        v["confidence"] = m.confidence;
       }
+      node[m.name] = std::move(v);
     }
-    if (n.skips > 0) put("skipped", static_cast<double>(n.skips));
-    f << "\n  }";
+    if (n.skips > 0) node["skipped"] = {{"value", n.skips}, {"unit", ""}};
+    j[n.id] = std::move(node);
   }
-  f << "\n}\n";
+  std::ofstream f(path);
+  if (!f) throw ConfigError("cannot write metrics JSON '" + path + "'");
+  f << j.dump(2) << "\n";
   if (!f) throw ConfigError("error writing metrics JSON '" + path + "'");
 }
 

@@ -9,6 +9,7 @@ mkdir -p "$TMP/plugins"
 cp "$PLUGINS"/tfplugin_*.so "$TMP/plugins/"
 list() { "$TF" plugins --json --no-default-plugins --plugin-path "$TMP/plugins"; }
 types() { list | grep -o '"type": "[a-z_.]*"' | sed 's/"type": //; s/"//g' | sort; }
+objects() { list | tr -d '\n' | sed 's/}/}\n/g'; }  # one JSON object of "types" per line
 
 expected="convert.classical filter.kalman sim.radar sim.trajectory sink.csv sink.metrics source.csv"
 for t in $expected; do
@@ -19,10 +20,10 @@ checks=$((checks + 1))
 
 # One file per type among the seven.
 for t in $expected; do
-  n=$(list | grep "\"type\": \"$t\"" | grep -o '"file": "[^"]*"' | sort -u | wc -l)
+  n=$(objects | grep "\"type\": \"$t\"" | grep -o '"file": "[^"]*"' | sort -u | wc -l)
   [ "$n" -eq 1 ] || fail "type $t comes from $n files"
 done
-files=$(for t in $expected; do list | grep "\"type\": \"$t\"" | grep -o '"file": "[^"]*"'; done | sort -u | wc -l)
+files=$(for t in $expected; do objects | grep "\"type\": \"$t\"" | grep -o '"file": "[^"]*"'; done | sort -u | wc -l)
 [ "$files" -eq 7 ] || fail "the seven types come from $files files, expected 7"
 echo "ok: each of the seven types comes from its own .so"
 checks=$((checks + 1))

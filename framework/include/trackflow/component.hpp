@@ -3,6 +3,7 @@
 
 #include <trackflow/items.hpp>
 #include <trackflow/noise.hpp>
+#include <trackflow/series.hpp>
 
 #include <boost/config.hpp>
 
@@ -60,6 +61,7 @@ struct Summary {
   std::vector<Metric> metrics;
   std::vector<std::string> notes;
   std::vector<std::string> files;
+  std::vector<Series> series;  // per-step tables for `run --series` and `trackflow report` (appended: old plugins never touch it)
   void metric(std::string name, double v, std::string unit = {}) {
     metrics.push_back({std::move(name), v, std::move(unit)});
   }

@@ -21,6 +21,12 @@ constexpr const char* kHeader =
     "run,time,source,kind,updated,x,y,z,vx,vy,vz,sigma_x,sigma_y,sigma_z,sigma_vx,sigma_vy,sigma_vz,nis,nees,"
     "truth_x,truth_y,truth_z,truth_vx,truth_vy,truth_vz";
 
+// Opt-in (full_covariance): the upper triangle of the ENU covariance, row by row; units m2,
+// m2/s and m2/s2 (the sigma_* columns are the square roots of its diagonal).
+constexpr const char* kCovarianceHeader =
+    ",cov_x_x,cov_x_y,cov_x_z,cov_x_vx,cov_x_vy,cov_x_vz,cov_y_y,cov_y_z,cov_y_vx,cov_y_vy,cov_y_vz,cov_z_z,cov_z_vx,"
+    "cov_z_vy,cov_z_vz,cov_vx_vx,cov_vx_vy,cov_vx_vz,cov_vy_vy,cov_vy_vz,cov_vz_vz";
+
 // Truth samples within this of an item's time are its truth (the same default as sink.metrics).
 constexpr double kTimeTolerance = 1e-6;
 
@@ -52,6 +58,7 @@ class CsvSink final : public Component {
       : path_(p.has("path") ? p.text("path") : std::string()),
         path_where_(p.where("path")),
         include_measurements_(p.boolean("include_measurements")),
+        full_covariance_(p.boolean("full_covariance")),
         precision_(static_cast<int>(p.integer("precision"))) {
     if (p.has("path") && path_.empty()) throw p.error("path", "must not be empty (leave it out for '<node id>.csv')");
     truth_.reserve(4096);
@@ -128,6 +135,7 @@ class CsvSink final : public Component {
       r.has_sigma = m.covariance.rows() >= 3 && m.covariance.cols() >= 3;
       for (int i = 0; i < 3 && r.has_sigma; ++i)
         r.sigma(i) = m.covariance(i, i) >= 0.0 ? std::sqrt(m.covariance(i, i)) : NAN;
+      if (r.has_sigma) r.covariance.topLeftCorner<3, 3>() = m.covariance.topLeftCorner(3, 3);
     } else {
       r.value.head<3>() = spherical_to_enu(m.value(0), m.value(1), m.value(2), m.azimuth) + m.sensor_position;
     }
@@ -158,6 +166,7 @@ class CsvSink final : public Component {
     std::ofstream os(file, std::ios::binary | std::ios::trunc);
     if (os) {
       os << kHeader;
+      if (full_covariance_) os << kCovarianceHeader;
       for (const auto& name : annotation_columns_) os << ',' << csv::quoted(name);
       os << '\n';
       os.write(file_.data(), static_cast<std::streamsize>(file_.size()));
@@ -237,6 +246,9 @@ class CsvSink final : public Component {
       for (int i = 0; i < r.annotation_count && static_cast<size_t>(i) < columns.size(); ++i)
         row_annotations_[static_cast<size_t>(columns[static_cast<size_t>(i)])] = r.annotations[i];
     }
+    if (full_covariance_)
+      for (int i = 0; i < 6; ++i)
+        for (int j = i; j < 6; ++j) w.real_if(r.has_sigma && (j < 3 || r.has_velocity), r.covariance(i, j));
     for (double a : row_annotations_) w.real_if(!std::isnan(a), a);
     w.end();
     ++row_count_;
@@ -245,6 +257,7 @@ class CsvSink final : public Component {
   const std::string path_;
   const SourceLoc path_where_;
   const bool include_measurements_;
+  const bool full_covariance_;
   const int precision_;
   std::vector<std::string> sources_;
   std::vector<std::string> annotation_columns_;
@@ -270,19 +283,24 @@ void register_components(Registrar& r) {
   d.kind = ComponentKind::Sink;
   d.summary = "Writes estimates (any number of filters), optional measurements and matching truth of all runs to one CSV file";
   d.doc =
-      "Columns: run,time,source,kind,updated,x,y,z,vx,vy,vz,sigma_x..sigma_vz,nis,nees,truth_x..truth_vz, then one "
-      "column per annotation the pipeline's adapters publish on the estimates of this sink's inputs, named "
-      "<adapter id>.<name> (e.g. qs.grade_range: adapt.quality_switch's grade, 0 best, 1 normal, 2 worst; "
-      "adaptive_r.sigma_x: adapt.innovation_r's adapted sigma, m), empty when the adapter has published none yet. "
-      "source is the upstream node id; kind is estimate or measurement. Truth columns and nees are filled when a "
-      "truth sample lies within 1 us of the row's time, nis when the estimate was updated; missing values are "
-      "empty cells. "
+      "Columns: run,time,source,kind,updated,x,y,z,vx,vy,vz,sigma_x..sigma_vz,nis,nees,truth_x..truth_vz"
+      "[,cov_x_x,cov_x_y,...,cov_vz_vz], then one column per annotation the pipeline's adapters publish on the "
+      "estimates of this sink's inputs, named <adapter id>.<name> (e.g. qs.grade_range: adapt.quality_switch's "
+      "grade, 0 best, 1 normal, 2 worst; adaptive_r.sigma_x: adapt.innovation_r's adapted sigma, m), empty when the "
+      "adapter has published none yet. source is the upstream node id; kind is estimate or measurement. Truth "
+      "columns and nees are filled when a truth sample lies within 1 us of the row's time, nis when the estimate "
+      "was updated; missing values are empty cells. With full_covariance: true, 21 more columns hold the upper "
+      "triangle of the ENU covariance row by row (x y z vx vy vz; m2, m2/s, m2/s2; Cartesian measurement rows: their "
+      "position block). "
       "Measurement rows carry the Cartesian position (spherical ones converted) and, when Cartesian, the sigmas "
       "of the covariance diagonal. Only initialised estimates and valid measurements are written. Rows are in "
       "run order, then arrival order, so the file is identical for a given seed whatever the thread count.";
   d.params = {
       ParamSpec::string("path", "output file relative to --out (default: <node id>.csv)"),
       ParamSpec::boolean("include_measurements", "also write measurement rows").def("false"),
+      ParamSpec::boolean("full_covariance",
+                         "also write the upper triangle of the ENU covariance (cov_x_x ... cov_vz_vz; m2, m2/s, m2/s2)")
+          .def("false"),
       ParamSpec::integer("precision", "significant digits of numbers").def("10").at_least(1).at_most(17),
   };
   d.accepts = ItemKind::Estimate | ItemKind::Truth | mask(ItemKind::Measurement);

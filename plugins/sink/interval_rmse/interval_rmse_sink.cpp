@@ -120,6 +120,7 @@ class IntervalRmseSink final : public Component {
         s.notes.push_back("interval " + at + ": no ratio (it lacks filter estimates or measurements)");
       }
     }
+    s.series.push_back(series());
     s.metric("intervals", static_cast<double>(compared));
     if (compared) s.metric("max_ratio", worst);
     s.metric("non_finite_estimates", static_cast<double>(non_finite_));
@@ -158,6 +159,25 @@ class IntervalRmseSink final : public Component {
     }
   }
 
+  // The same numbers per interval as a table (`run --series`, `trackflow report`).
+  Series series() const {
+    Series t;
+    t.name = "intervals";
+    t.description = "per interval [start, start + interval): ensemble position RMSE of the filter and of the measurements";
+    t.add_column("interval_start", "s");
+    t.add_column("filter_rmse", "m");
+    t.add_column("measurement_rmse", "m");
+    t.add_column("ratio");
+    for (size_t i = 0; i < bins_.size(); ++i) {
+      const Bin& b = bins_[i];
+      if (b.filter_n == 0 && b.measurement_n == 0) continue;
+      const double f = b.filter_n ? std::sqrt(b.filter_sq / static_cast<double>(b.filter_n)) : NAN;
+      const double m = b.measurement_n ? std::sqrt(b.measurement_sq / static_cast<double>(b.measurement_n)) : NAN;
+      t.values.insert(t.values.end(), {start_ + static_cast<double>(i) * interval_, f, m, m > 0.0 ? f / m : NAN});
+    }
+    return t;
+  }
+
   std::string label(size_t i) const {
     char buf[40];
     std::snprintf(buf, sizeof buf, "%gs", start_ + static_cast<double>(i) * interval_);
@@ -187,7 +207,8 @@ void register_components(Registrar& r) {
       "of the initialised estimates' position error, measurement_rmse_<t0>s the same for the valid measurements "
       "(spherical ones converted to ENU), ratio_<t0>s their quotient (t0 = the interval's start, '.' written 'p'). "
       "max_ratio is the largest ratio: below 1, the filter beats the raw measurements in every interval. Items "
-      "earlier than the first estimate + skip_initial are left out. Truth is matched as in sink.metrics.";
+      "earlier than the first estimate + skip_initial are left out. Truth is matched as in sink.metrics. The same "
+      "numbers are published as the series 'intervals' (`trackflow run --series`, `trackflow report`).";
   d.params = {
       ParamSpec::real("interval", dim::time, "length of each interval").def("60 s").positive(),
       ParamSpec::real("start", dim::time, "start of the first interval").def("0 s"),

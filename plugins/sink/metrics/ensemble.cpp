@@ -21,8 +21,17 @@ void Ensemble::add(const MetricsRunResult& run) {
   measurements_matched += run.measurements_matched;
   measurements_unmatched += run.measurements_unmatched;
   for (const EstimateRecord& r : run.records) {
-    ++estimates;
     StepSums& s = steps[r.key];
+    if (!s.has_time) {
+      s.time = r.time;
+      s.has_time = true;
+    }
+    ++s.published;
+    s.initialised += r.initialised ? 1 : 0;
+    s.updated += r.updated ? 1 : 0;
+    if (r.initialised) s.annotations.add(r.annotation, annotation_channels);
+    if (!r.scored) continue;
+    ++estimates;
     ++s.estimates;
     if (r.matched) {
       ++s.matched;
@@ -47,6 +56,15 @@ void Ensemble::add(const MetricsRunResult& run) {
         ++innovation_count[i];
       }
     }
+  }
+  for (const MeasurementRecord& m : run.measurement_records) {
+    StepSums& s = steps[m.key];
+    if (!s.has_time) {
+      s.time = m.time;
+      s.has_time = true;
+    }
+    ++s.measurements;
+    s.measurement_sq += m.sq_error;
   }
 }
 

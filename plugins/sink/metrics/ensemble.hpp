@@ -1,6 +1,8 @@
 // Purpose: sink.metrics' per-run records and their run-ordered accumulation per time step.
 #pragma once
 
+#include "annotation_channels.hpp"
+
 #include <trackflow/component.hpp>
 
 #include <cstdint>
@@ -11,9 +13,14 @@ namespace trackflow::metrics {
 
 using InnovationVec = Eigen::Matrix<double, kMaxMeasDim, 1>;
 
-// One evaluated estimate of one run.
+// One estimate of one run. Every published estimate has a record (for the per-step fractions
+// of runs initialised and updated); only `scored` ones enter the error metrics.
 struct EstimateRecord {
   long long key = 0;        // llround(time / time_tolerance): the time step across runs
+  double time = 0.0;
+  bool initialised = false, updated = false;
+  bool scored = false;      // initialised, finite and after first estimate + skip_initial
+  float annotation[kMaxAnnotations] = {};  // AnnotationChannels::read, NaN: absent (float: kept per run)
   bool matched = false;     // a truth state exists at this time
   bool has_nees = false;    // matched and the covariance is positive definite
   Vec6 error = Vec6::Zero();  // estimate - truth, ENU [position; velocity]
@@ -23,8 +30,16 @@ struct EstimateRecord {
   InnovationVec innovation = InnovationVec::Zero();
 };
 
+// A valid measurement of one run matched to truth (for the per-step measurement RMSE).
+struct MeasurementRecord {
+  long long key = 0;
+  double time = 0.0;
+  double sq_error = 0.0;
+};
+
 struct MetricsRunResult final : RunResult {
   std::vector<EstimateRecord> records;
+  std::vector<MeasurementRecord> measurement_records;
   bool had_truth = false;
   std::uint64_t before_window = 0;          // earlier than first estimate + skip_initial
   std::uint64_t non_finite = 0;             // estimates whose ENU state or time is not finite
@@ -36,7 +51,13 @@ struct MetricsRunResult final : RunResult {
 };
 
 struct StepSums {
-  std::uint64_t estimates = 0, matched = 0;
+  double time = 0.0;  // of the first run that reached this step
+  bool has_time = false;
+  std::uint64_t published = 0, initialised = 0, updated = 0;  // estimates of any kind
+  AnnotationSums annotations;
+  std::uint64_t measurements = 0;
+  double measurement_sq = 0.0;
+  std::uint64_t estimates = 0, matched = 0;  // scored estimates
   double sq[6] = {};   // sum of squared errors per ENU component
   double sum[6] = {};  // sum of errors (bias)
   std::uint64_t nees_count = 0;
@@ -55,6 +76,7 @@ struct Ensemble {
   double innovation_sum[kMaxMeasDim] = {};
   std::uint64_t innovation_count[kMaxMeasDim] = {};
   int nis_dof_min = kMaxMeasDim + 1, nis_dof_max = 0;
+  int annotation_channels = 0;
 
   void add(const MetricsRunResult& run);
 };
@@ -67,5 +89,10 @@ struct ReportOptions {
 };
 
 void report(const Ensemble& e, const ReportOptions& opt, Summary& summary);
+
+// The per-step ensemble series (one row per time step): RMSE, mean errors, ANEES and ANIS
+// with their per-step chi-square bands, measurement RMSE, fractions of runs initialised and
+// updated, and the per-step mean of each annotation channel that occurs.
+Series ensemble_series(const Ensemble& e, const ReportOptions& opt, const AnnotationChannels& channels);
 
 }  // namespace trackflow::metrics

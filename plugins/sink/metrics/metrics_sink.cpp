@@ -7,7 +7,9 @@
 
 #include <Eigen/Cholesky>
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
 #include <limits>
 
 namespace trackflow {
@@ -21,13 +23,17 @@ using metrics::MetricsRunResult;
 class MetricsSink final : public Component {
  public:
   explicit MetricsSink(const Params& p)
-      : skip_initial_(p.real("skip_initial")), confidence_(p.real("confidence")), tolerance_(p.real("time_tolerance")) {
+      : skip_initial_(p.real("skip_initial")),
+        confidence_(p.real("confidence")),
+        tolerance_(p.real("time_tolerance")),
+        series_(p.boolean("series")) {
     if (!(confidence_ > 0.0 && confidence_ < 1.0))
       throw p.error("confidence", "must lie strictly between 0 and 1 (e.g. 0.95)");
     constexpr size_t kReserve = 4096;
     truth_.reserve(kReserve);
     estimates_.reserve(kReserve);
     measurements_.reserve(kReserve);
+    ensemble_.annotation_channels = series_ ? channels_.count() : 0;
   }
 
   void set_inputs(const std::vector<InputInfo>& inputs) override {
@@ -36,6 +42,8 @@ class MetricsSink final : public Component {
     for (const auto& in : inputs) {
       if (in.kinds & mask(ItemKind::Estimate)) {
         estimate_sources += (estimate_inputs++ ? ", '" : "'") + in.node + "'";
+        channels_ = metrics::AnnotationChannels(in.annotations);
+        ensemble_.annotation_channels = series_ ? channels_.count() : 0;
       }
       truth_input_ |= (in.kinds & mask(ItemKind::Truth)) != 0;
       measurement_input_ |= (in.kinds & mask(ItemKind::Measurement)) != 0;
@@ -54,9 +62,20 @@ class MetricsSink final : public Component {
 
   void on_truth(const Truth& t, int) override { metrics::insert_truth(truth_, t); }
 
+  // Every estimate is kept (uninitialised ones only count towards the per-step fractions).
   void on_estimate(const Estimate& e, int) override {
+    if (!e.initialised && !series_) return;
+    StoredEstimate& s = estimates_.emplace_back();
+    s.time = e.time;
+    s.target = e.target;
+    s.initialised = e.initialised;
+    s.updated = e.updated;
     if (!e.initialised) return;
-    estimates_.push_back({e.time, e.target, e.updated, e.nis, e.enu, e.enu_covariance, e.innovation});
+    s.nis = e.nis;
+    s.enu = e.enu;
+    s.covariance = e.enu_covariance;
+    s.innovation = e.innovation;
+    if (series_) channels_.read(e, s.annotation);
   }
 
   void on_measurement(const Measurement& m, int) override {
@@ -71,17 +90,29 @@ class MetricsSink final : public Component {
     auto r = std::make_unique<MetricsRunResult>();
     r->had_truth = !truth_.empty();
     r->records.reserve(estimates_.size());
+    r->measurement_records.reserve(measurements_.size());
     const double start = window_start();
     for (const StoredEstimate& e : estimates_) {
+      if (!std::isfinite(e.time)) {
+        if (e.initialised) ++r->non_finite;
+        continue;
+      }
+      EstimateRecord& rec = r->records.emplace_back();
+      rec.key = std::llround(e.time / tolerance_);
+      rec.time = e.time;
+      rec.initialised = e.initialised;
+      rec.updated = e.initialised && e.updated;
+      if (!e.initialised) continue;
+      std::copy(std::begin(e.annotation), std::end(e.annotation), std::begin(rec.annotation));
       if (e.time + tolerance_ < start) {
         ++r->before_window;
         continue;
       }
-      if (!e.enu.allFinite() || !std::isfinite(e.time)) {
+      if (!e.enu.allFinite()) {
         ++r->non_finite;
         continue;
       }
-      r->records.push_back(evaluate(e, *r));
+      evaluate(e, rec, *r);
     }
     measurement_errors(start, *r);
     return r;
@@ -90,18 +121,21 @@ class MetricsSink final : public Component {
   void merge(RunResult& result) override { ensemble_.add(static_cast<MetricsRunResult&>(result)); }
 
   void finish(Summary& summary, const FinishContext&) override {
-    metrics::report(ensemble_, {confidence_, skip_initial_, truth_input_, measurement_input_}, summary);
+    const metrics::ReportOptions opt{confidence_, skip_initial_, truth_input_, measurement_input_};
+    metrics::report(ensemble_, opt, summary);
+    if (series_ && ensemble_.runs > 0) summary.series.push_back(metrics::ensemble_series(ensemble_, opt, channels_));
   }
 
  private:
   struct StoredEstimate {
-    double time;
-    std::uint32_t target;
-    bool updated;
-    double nis;
+    double time = 0.0;
+    std::uint32_t target = 0;
+    bool initialised = false, updated = false;
+    double nis = 0.0;
     Vec6 enu;
     Mat6 covariance;
     MeasVec innovation;
+    float annotation[metrics::kMaxAnnotations] = {};
   };
   struct StoredMeasurement {
     double time;
@@ -112,15 +146,15 @@ class MetricsSink final : public Component {
   // estimates (a measurement-only baseline) starts at its first measurement.
   double window_start() const {
     double first = std::numeric_limits<double>::infinity();
-    for (const auto& e : estimates_) first = std::min(first, e.time);
+    for (const auto& e : estimates_)
+      if (e.initialised) first = std::min(first, e.time);
     if (!std::isfinite(first))
       for (const auto& m : measurements_) first = std::min(first, m.time);
     return first + skip_initial_;
   }
 
-  EstimateRecord evaluate(const StoredEstimate& e, MetricsRunResult& r) const {
-    EstimateRecord rec;
-    rec.key = std::llround(e.time / tolerance_);
+  void evaluate(const StoredEstimate& e, EstimateRecord& rec, MetricsRunResult& r) const {
+    rec.scored = true;
     const int m = static_cast<int>(e.innovation.size());
     if (e.updated && m > 0 && std::isfinite(e.nis)) {
       rec.nis_dof = m;
@@ -130,7 +164,7 @@ class MetricsSink final : public Component {
     Vec6 truth;
     if (!metrics::truth_at(metrics::truth_for(truth_, e.target), e.time, tolerance_, truth)) {
       ++r.unmatched;
-      return rec;
+      return;
     }
     rec.matched = true;
     rec.error = e.enu - truth;
@@ -143,7 +177,6 @@ class MetricsSink final : public Component {
       rec.has_nees = std::isfinite(rec.nees) && std::isfinite(rec.nees_position);
     }
     if (!rec.has_nees) ++r.not_positive_definite;
-    return rec;
   }
 
   void measurement_errors(double start, MetricsRunResult& r) const {
@@ -154,8 +187,10 @@ class MetricsSink final : public Component {
       if (m.time + tolerance_ < start) continue;
       Vec6 truth;
       if (usable && metrics::truth_at(span, m.time, tolerance_, truth)) {
-        r.measurement_sq_error += (m.position - truth.head<3>()).squaredNorm();
+        const double sq = (m.position - truth.head<3>()).squaredNorm();
+        r.measurement_sq_error += sq;
         ++r.measurements_matched;
+        if (series_) r.measurement_records.push_back({std::llround(m.time / tolerance_), m.time, sq});
       } else {
         ++r.measurements_unmatched;
       }
@@ -163,10 +198,12 @@ class MetricsSink final : public Component {
   }
 
   const double skip_initial_, confidence_, tolerance_;
+  const bool series_;
   bool truth_input_ = false, measurement_input_ = false;
   std::vector<Truth> truth_;
   std::vector<StoredEstimate> estimates_;
   std::vector<StoredMeasurement> measurements_;
+  metrics::AnnotationChannels channels_;
   metrics::Ensemble ensemble_;
 };
 
@@ -183,7 +220,11 @@ void register_components(Registrar& r) {
       "step (n = 6, or 3 for anees_position); anees is its mean over steps, with the per-step band "
       "[chi2inv((1-c)/2, nM), chi2inv((1+c)/2, nM)]/(nM) (Bar-Shalom, Li & Kirubarajan 2001 §5.4.2). ANIS "
       "likewise with the innovation dimension. Without truth (recorded logs) only anis, mean_innovation_<i> "
-      "and counts are reported. Only initialised estimates are scored.";
+      "and counts are reported. Only initialised estimates are scored. Per time step it also publishes the "
+      "ensemble series (`trackflow run --series`, `trackflow report`): position/velocity RMSE, mean error per axis, "
+      "ANEES and ANIS with the band for the runs at that step, measurement RMSE, fractions of runs initialised and "
+      "updated, and the mean of each adapter annotation (e.g. quality grades, adapted sigmas); the series' mean ANEES "
+      "is anees.";
   d.params = {
       ParamSpec::real("skip_initial", dim::time, "leave out estimates earlier than the first initialised estimate + this (transient)")
           .def("0 s")
@@ -195,6 +236,10 @@ void register_components(Registrar& r) {
       ParamSpec::real("time_tolerance", dim::time, "items closer in time than this are the same time step")
           .def("1 us")
           .positive(),
+      ParamSpec::boolean("series",
+                         "publish the per-step ensemble series (measurement RMSE, fractions of runs, annotations per "
+                         "step); false keeps only what the summary needs")
+          .def("true"),
   };
   d.accepts = ItemKind::Estimate | ItemKind::Truth | mask(ItemKind::Measurement);
   d.min_inputs = 1;

@@ -22,9 +22,8 @@ std::vector<ExpectResult> check_expects(const Graph& g, const Outcome& out);
 
 void print_summary(std::ostream& os, const Graph& g, const Outcome& out, unsigned threads,
                    const std::vector<ExpectResult>& expects);
-// { "<node id>": { "<metric>": value, "<metric>_band_lo": ..., ... }, ... } for nodes with metrics.
+// { "<node id>": { "<metric>": { "value": v, "unit": "m"[, "band_lo", "band_hi", "confidence"] }, ... } }
+// for nodes with metrics; a value that is not finite is null.
 void write_metrics_json(const std::string& path, const Outcome& out);
-std::string json_escape(const std::string& s);
-std::string json_number(double v);  // null for NaN/inf
 
 }  // namespace trackflow::host

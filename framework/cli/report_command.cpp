@@ -1,0 +1,69 @@
+// Purpose: the track recorder node, the series CSV files and the HTML report of `run --series/--report` and `report`.
+#include "report_command.hpp"
+
+#include "html_report.hpp"
+#include "series_csv.hpp"
+
+#include <filesystem>
+
+namespace trackflow::cli {
+
+std::string add_track_recorder(host::PipelineConfig& cfg, const host::PluginRegistry& reg, std::uint64_t run) {
+  std::string id = "report_track";
+  auto taken = [&](const std::string& s) {
+    for (const auto& n : cfg.nodes)
+      if (n.id == s) return true;
+    return false;
+  };
+  for (int k = 2; taken(id); ++k) id = "report_track_" + std::to_string(k);
+  host::NodeConfig n;
+  n.id = id;
+  n.type = "sink.track";
+  for (const auto& other : cfg.nodes) {
+    const auto* t = reg.find(other.type);
+    if (!t || t->decl.produces == 0 || t->decl.kind == ComponentKind::Adapter) continue;
+    n.inputs.push_back(other.id);
+    n.input_locs.push_back(other.loc);
+  }
+  if (n.inputs.empty()) return {};
+  n.params.kind = host::Value::Kind::Map;
+  host::Value v;
+  v.kind = host::Value::Kind::Scalar;
+  v.scalar = std::to_string(run);
+  n.params.entries.push_back({"run", v});
+  n.params.key_locs.push_back({});
+  cfg.nodes.push_back(std::move(n));
+  return id;
+}
+
+std::vector<std::string> write_report_outputs(const ReportRequest& req, const host::Graph& g, const host::Outcome& out,
+                                              const std::vector<host::ExpectResult>& expects, unsigned threads) {
+  std::vector<std::string> files;
+  if (!req.series_dir.empty()) files = report::write_all_series(req.series_dir, out);
+  if (!req.html.empty()) {
+    report::RunReport r;
+    r.graph = &g;
+    r.outcome = &out;
+    r.expects = &expects;
+    r.threads = threads;
+    r.command = req.command;
+    r.track_node = req.track_node;
+    r.track_run = req.track_run;
+    r.files = files;
+    report::write_text_file(req.html, report::render_run_report(r));
+    files.push_back(req.html);
+  }
+  return files;
+}
+
+std::string command_line(int argc, char** argv) {
+  std::string s = "trackflow";
+  for (int i = 0; i < argc; ++i) {
+    std::string a = argv[i];
+    if (a.find_first_of(" \"'$") != std::string::npos) a = "'" + a + "'";
+    s += " " + a;
+  }
+  return s;
+}
+
+}  // namespace trackflow::cli

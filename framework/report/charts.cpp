@@ -1,0 +1,303 @@
+// Purpose: Vega-Lite specs of the report's plots, built as JSON values.
+#include "charts.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <limits>
+
+namespace trackflow::report {
+namespace {
+
+constexpr int kWidth = 860, kHeight = 260;
+
+size_t stride_for(size_t n) { return n <= kMaxPointsPerLine ? 1 : (n + kMaxPointsPerLine - 1) / kMaxPointsPerLine; }
+
+json base_spec(const std::string& title) {
+  return {{"$schema", "https://vega.github.io/schema/vega-lite/v6.json"},
+          {"title", title},
+          {"width", kWidth},
+          {"height", kHeight},
+          {"config", {{"font", "sans-serif"}, {"legend", {{"orient", "top"}, {"labelLimit", 320}}}}}};
+}
+
+// Appends the finite points of `line` to `values` as {x, y, s[, o]}; returns how many.
+long append_points(json& values, const Line& line, const std::vector<double>* order = nullptr) {
+  long n = 0;
+  const size_t step = stride_for(line.x.size());
+  for (size_t i = 0; i < line.x.size() && i < line.y.size(); i += step) {
+    if (!std::isfinite(line.x[i]) || !std::isfinite(line.y[i])) continue;
+    json p = {{"x", round6(line.x[i])}, {"y", round6(line.y[i])}, {"s", line.label}};
+    if (order && i < order->size()) p["o"] = (*order)[i];
+    values.push_back(std::move(p));
+    ++n;
+  }
+  return n;
+}
+
+json labels(const std::vector<Line>& lines) {
+  json d = json::array();
+  for (const auto& l : lines) d.push_back(l.label);
+  return d;
+}
+
+bool all_positive(const std::vector<Line>& lines) {
+  bool any = false;
+  for (const auto& l : lines)
+    for (double v : l.y)
+      if (std::isfinite(v)) {
+        if (v <= 0) return false;
+        any = true;
+      }
+  return any;
+}
+
+}  // namespace
+
+double round6(double v) {
+  if (!std::isfinite(v) || v == 0.0) return v;
+  char buf[32];
+  std::snprintf(buf, sizeof buf, "%.6g", v);
+  return std::strtod(buf, nullptr);
+}
+
+Chart line_chart(const std::string& title, const std::string& x_title, const std::string& y_title,
+                 const std::vector<Line>& lines, bool log_y) {
+  Chart c;
+  c.title = title;
+  json values = json::array();
+  for (const auto& l : lines) {
+    const long n = append_points(values, l);
+    if (n > 0) {
+      ++c.lines;
+      c.line_points += n;
+    }
+  }
+  const bool log = log_y && all_positive(lines);
+  c.spec = base_spec(title);
+  c.spec["data"] = {{"values", values}};
+  c.spec["mark"] = {{"type", "line"}, {"strokeWidth", 1.4}, {"clip", true}};
+  c.spec["params"] = json::array({{{"name", "zoom"}, {"select", "interval"}, {"bind", "scales"}}});
+  c.spec["encoding"] = {
+      {"x", {{"field", "x"}, {"type", "quantitative"}, {"title", x_title}}},
+      {"y", {{"field", "y"}, {"type", "quantitative"}, {"title", y_title}, {"scale", {{"type", log ? "log" : "linear"}, {"zero", false}}}}},
+      {"color", {{"field", "s"}, {"type", "nominal"}, {"title", nullptr}, {"scale", {{"domain", labels(lines)}}}}}};
+  return c;
+}
+
+Chart band_chart(const std::string& title, const std::string& y_title, const Line& value, const Line& band_lo,
+                 const Line& band_hi, const std::string& band_label) {
+  Chart c;
+  c.title = title;
+  json band = json::array();
+  const size_t step = stride_for(band_lo.x.size());
+  for (size_t i = 0; i < band_lo.x.size() && i < band_hi.y.size(); i += step) {
+    if (!std::isfinite(band_lo.x[i]) || !std::isfinite(band_lo.y[i]) || !std::isfinite(band_hi.y[i])) continue;
+    band.push_back({{"x", round6(band_lo.x[i])}, {"lo", round6(band_lo.y[i])}, {"hi", round6(band_hi.y[i])}});
+  }
+  json values = json::array();
+  c.line_points = append_points(values, value);
+  c.lines = c.line_points > 0 ? 1 : 0;
+  c.areas = band.empty() ? 0 : 1;
+  // A log scale when the value leaves the band by far (an inconsistent filter), so both show.
+  double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
+  for (const auto& v : values) {
+    lo = std::min(lo, v["y"].get<double>());
+    hi = std::max(hi, v["y"].get<double>());
+  }
+  for (const auto& b : band) {
+    lo = std::min(lo, b["lo"].get<double>());
+    hi = std::max(hi, b["hi"].get<double>());
+  }
+  const bool log = lo > 0.0 && hi / lo > 20.0;
+  const json yscale = {{"type", log ? "log" : "linear"}, {"zero", false}};
+  c.spec = base_spec(title);
+  c.spec["layer"] = json::array(
+      {{{"data", {{"values", band}}},
+        {"mark", {{"type", "area"}, {"opacity", 0.25}, {"color", "#4c78a8"}, {"clip", true}}},
+        {"encoding",
+         {{"x", {{"field", "x"}, {"type", "quantitative"}, {"title", "time [s]"}}},
+          {"y", {{"field", "lo"}, {"type", "quantitative"}, {"title", y_title}, {"scale", yscale}}},
+          {"y2", {{"field", "hi"}}}}}},
+       {{"data", {{"values", values}}},
+        {"mark", {{"type", "line"}, {"strokeWidth", 1.4}, {"clip", true}}},
+        {"params", json::array({{{"name", "zoom"}, {"select", "interval"}, {"bind", "scales"}}})},
+        {"encoding",
+         {{"x", {{"field", "x"}, {"type", "quantitative"}}},
+          {"y", {{"field", "y"}, {"type", "quantitative"}, {"scale", yscale}}},
+          {"color", {{"field", "s"}, {"type", "nominal"}, {"title", nullptr},
+                     {"scale", {{"range", json::array({"#d62728"})}}}}}}}}});
+  c.caption = "shaded: " + band_label;
+  return c;
+}
+
+Chart track_chart(const std::string& title, const std::string& x_title, const std::string& y_title,
+                  const std::vector<Line>& paths, const std::vector<Line>& points, bool equal_axes) {
+  Chart c;
+  c.title = title;
+  json line_values = json::array(), point_values = json::array();
+  for (const auto& l : paths) {
+    // Draw in time order even when x is not monotonic (a ground track): "o" is the sample index.
+    std::vector<double> order(l.x.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<double>(i);
+    const long n = append_points(line_values, l, &order);
+    if (n > 0) {
+      ++c.lines;
+      c.line_points += n;
+    }
+  }
+  for (const auto& p : points) c.symbols += append_points(point_values, p);
+  std::vector<Line> all = points;
+  all.insert(all.end(), paths.begin(), paths.end());
+  json xscale = {{"zero", false}}, yscale = {{"zero", false}};
+  int width = kWidth, height = equal_axes ? 420 : kHeight;
+  if (equal_axes) {
+    // Same metres per pixel on both axes, so the geometry is not distorted.
+    double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
+    for (const auto& l : all)
+      for (size_t i = 0; i < l.x.size() && i < l.y.size(); ++i)
+        if (std::isfinite(l.x[i]) && std::isfinite(l.y[i])) {
+          x0 = std::min(x0, l.x[i]);
+          x1 = std::max(x1, l.x[i]);
+          y0 = std::min(y0, l.y[i]);
+          y1 = std::max(y1, l.y[i]);
+        }
+    const double sx = std::max(x1 - x0, 1.0), sy = std::max(y1 - y0, 1.0);
+    // A track much longer than wide (a straight approach) would be a flat line at equal
+    // scales: then each axis gets its own scale, and the caption says so.
+    if (std::isfinite(x0) && std::isfinite(y0) && std::max(sx / sy, sy / sx) > 8.0) {
+      c.caption = "axes scaled independently (the track is " + std::to_string(static_cast<long>(std::max(sx, sy))) +
+                  " m long and " + std::to_string(static_cast<long>(std::min(sx, sy))) + " m wide)";
+      height = kHeight + 60;
+    } else if (std::isfinite(x0) && std::isfinite(y0)) {
+      c.caption = "equal scales on both axes";
+      const double per_px = std::max(sx / width, sy / height) * 1.05;
+      const double cx = 0.5 * (x0 + x1), cy = 0.5 * (y0 + y1);
+      xscale["domain"] = {round6(cx - per_px * width / 2), round6(cx + per_px * width / 2)};
+      yscale["domain"] = {round6(cy - per_px * height / 2), round6(cy + per_px * height / 2)};
+    }
+  }
+  json domain = labels(all);
+  // Truth in black, measurements in pale colours, estimates in strong ones.
+  const char* pale[] = {"#9ecae1", "#c7c7c7", "#fdd0a2", "#c7e9c0"};
+  const char* strong[] = {"#d62728", "#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2"};
+  json range = json::array();
+  size_t np = 0, ns = 0;
+  for (size_t i = 0; i < points.size(); ++i) range.push_back(pale[np++ % 4]);
+  for (const auto& l : paths)
+    range.push_back(l.label == "truth" || l.label.find("(truth)") != std::string::npos ? "#000000" : strong[ns++ % 7]);
+  c.spec = base_spec(title);
+  c.spec["width"] = width;
+  c.spec["height"] = height;
+  json color = {{"field", "s"}, {"type", "nominal"}, {"title", nullptr}, {"scale", {{"domain", domain}, {"range", range}}}};
+  c.spec["layer"] = json::array(
+      {{{"data", {{"values", point_values}}},
+        {"mark", {{"type", "point"}, {"filled", true}, {"size", 6}, {"opacity", 0.5}, {"clip", true}}},
+        {"encoding",
+         {{"x", {{"field", "x"}, {"type", "quantitative"}, {"title", x_title}, {"scale", xscale}}},
+          {"y", {{"field", "y"}, {"type", "quantitative"}, {"title", y_title}, {"scale", yscale}}},
+          {"color", color}}}},
+       {{"data", {{"values", line_values}}},
+        {"mark", {{"type", "line"}, {"strokeWidth", 1.4}, {"clip", true}}},
+        {"params", json::array({{{"name", "zoom"}, {"select", "interval"}, {"bind", "scales"}}})},
+        {"encoding",
+         {{"x", {{"field", "x"}, {"type", "quantitative"}, {"scale", xscale}}},
+          {"y", {{"field", "y"}, {"type", "quantitative"}, {"scale", yscale}}},
+          {"order", {{"field", "o"}}},
+          {"color", color}}}}});
+  return c;
+}
+
+Chart graph_chart(const std::vector<GraphNodeView>& nodes, const std::vector<GraphEdgeView>& edges) {
+  Chart c;
+  c.title = "pipeline";
+  int columns = 1, rows = 1;
+  for (const auto& n : nodes) {
+    columns = std::max(columns, n.column + 1);
+    rows = std::max(rows, n.row + 1);
+  }
+  // Boxes 150 x 45 px in cells of 170 x 80; an edge that skips columns bends above the boxes
+  // (each a little higher than the last) so that it is not hidden behind them.
+  const int col_w = 170, row_h = 80, half_w = 75, half_h = 22;
+  int skips = 0;
+  for (const auto& e : edges)
+    if (!e.attachment && nodes[static_cast<size_t>(e.to)].column - nodes[static_cast<size_t>(e.from)].column != 1) ++skips;
+  const int top = 12 + 12 * skips;
+  auto cx = [&](const GraphNodeView& n) { return n.column * col_w + col_w / 2; };
+  auto cy = [&](const GraphNodeView& n) { return top + n.row * row_h + row_h / 2; };
+  json node_values = json::array(), edge_values = json::array(), heads = json::array();
+  for (const auto& n : nodes)
+    node_values.push_back({{"x", cx(n)}, {"y", cy(n)}, {"id", n.id}, {"type", n.type}, {"kind", n.kind}});
+  int skip = 0;
+  for (size_t k = 0; k < edges.size(); ++k) {
+    const auto& e = edges[k];
+    const auto& a = nodes[static_cast<size_t>(e.from)];
+    const auto& b = nodes[static_cast<size_t>(e.to)];
+    std::vector<std::pair<int, int>> pts;
+    std::string head = "triangle-right";
+    if (e.attachment) {
+      const bool up = cy(a) > cy(b);
+      pts = {{cx(a), cy(a) + (up ? -half_h : half_h)}, {cx(b), cy(b) + (up ? half_h : -half_h) + (up ? 4 : -4)}};
+      head = up ? "triangle-up" : "triangle-down";
+    } else if (b.column - a.column == 1 && a.row == b.row) {
+      pts = {{cx(a) + half_w, cy(a)}, {cx(b) - half_w - 4, cy(b)}};
+    } else {
+      const int lift = 12 * (++skip);
+      const int y_top = std::min(cy(a), cy(b)) - half_h - lift + (b.column - a.column == 1 ? half_h + lift : 0);
+      pts = {{cx(a) + half_w, cy(a)},
+             {cx(a) + col_w / 2, y_top},
+             {cx(b) - col_w / 2, y_top},
+             {cx(b) - half_w - 4, cy(b)}};
+    }
+    for (size_t i = 0; i < pts.size(); ++i)
+      edge_values.push_back({{"x", pts[i].first}, {"y", pts[i].second}, {"e", static_cast<int>(k)}, {"i", static_cast<int>(i)},
+                             {"how", e.attachment ? "attached to" : "feeds"}});
+    heads.push_back({{"x", pts.back().first}, {"y", pts.back().second}, {"shape", head}});
+    ++c.lines;
+    c.line_points += static_cast<long>(pts.size());
+  }
+  const json xs = {{"domain", {0, columns * col_w}}, {"range", {0, columns * col_w}}};
+  const json ys = {{"domain", {0, top + rows * row_h}}, {"range", {0, top + rows * row_h}}};
+  auto pos = [&](const char* f, const json& scale) {
+    return json{{"field", f}, {"type", "quantitative"}, {"scale", scale}, {"axis", nullptr}};
+  };
+  c.spec = {{"$schema", "https://vega.github.io/schema/vega-lite/v6.json"},
+            {"width", columns * col_w},
+            {"height", top + rows * row_h},
+            {"view", {{"stroke", nullptr}}},
+            {"config", {{"font", "sans-serif"}, {"legend", {{"orient", "bottom"}, {"direction", "horizontal"}}}}},
+            {"layer",
+             json::array(
+                 {{{"data", {{"values", edge_values}}},
+                   {"mark", {{"type", "line"}, {"color", "#777"}, {"strokeWidth", 1.3}}},
+                   {"encoding",
+                    {{"x", pos("x", xs)},
+                     {"y", pos("y", ys)},
+                     {"detail", {{"field", "e"}, {"type", "nominal"}}},
+                     {"order", {{"field", "i"}}},
+                     {"strokeDash",
+                      {{"field", "how"}, {"type", "nominal"}, {"title", nullptr},
+                       {"scale", {{"domain", {"feeds", "attached to"}}, {"range", json::array({json::array({1, 0}), json::array({4, 3})})}}}}}}}},
+                  {{"data", {{"values", heads}}},
+                   {"mark", {{"type", "point"}, {"filled", true}, {"size", 40}, {"color", "#777"}, {"opacity", 1}}},
+                   {"encoding", {{"x", pos("x", xs)}, {"y", pos("y", ys)}, {"shape", {{"field", "shape"}, {"type", "nominal"}, {"scale", nullptr}, {"legend", nullptr}}}}}},
+                  {{"data", {{"values", node_values}}},
+                   {"mark", {{"type", "point"}, {"shape", "M-1,-0.3H1V0.3H-1Z"}, {"size", 4 * half_w * half_w}, {"filled", true}, {"opacity", 1}}},
+                   {"encoding",
+                    {{"x", pos("x", xs)},
+                     {"y", pos("y", ys)},
+                     {"color", {{"field", "kind"}, {"type", "nominal"}, {"title", "kind"}, {"scale", {{"scheme", "pastel1"}}}}},
+                     {"tooltip", json::array({{{"field", "id"}}, {{"field", "type"}}, {{"field", "kind"}}})}}}},
+                  {{"data", {{"values", node_values}}},
+                   {"mark", {{"type", "text"}, {"dy", -6}, {"fontWeight", "bold"}, {"fontSize", 12}}},
+                   {"encoding", {{"x", pos("x", xs)}, {"y", pos("y", ys)}, {"text", {{"field", "id"}}}}}},
+                  {{"data", {{"values", node_values}}},
+                   {"mark", {{"type", "text"}, {"dy", 9}, {"fontSize", 10}, {"color", "#333"}}},
+                   {"encoding", {{"x", pos("x", xs)}, {"y", pos("y", ys)}, {"text", {{"field", "type"}}}}}}})}};
+  c.symbols = static_cast<long>(nodes.size() + heads.size());
+  c.caption = "data flows left to right; dashed: an adapter attached to the filter it retunes";
+  return c;
+}
+
+}  // namespace trackflow::report

@@ -1,0 +1,595 @@
+// Purpose: assembles the HTML report: header, pipeline graph and table, summary and expects, plots of the nodes' series.
+#include "html_report.hpp"
+
+#include "charts.hpp"
+#include "pipeline_layout.hpp"
+#include "report_assets.hpp"
+
+#include <trackflow/version.hpp>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <set>
+
+namespace trackflow::report {
+namespace {
+
+std::string esc(const std::string& s) {
+  std::string o;
+  o.reserve(s.size());
+  for (char c : s) {
+    switch (c) {
+      case '&': o += "&amp;"; break;
+      case '<': o += "&lt;"; break;
+      case '>': o += "&gt;"; break;
+      case '"': o += "&quot;"; break;
+      default: o += c;
+    }
+  }
+  return o;
+}
+
+std::string num(double v) {
+  if (!std::isfinite(v)) return std::isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf");
+  char buf[40];
+  std::snprintf(buf, sizeof buf, "%.5g", v);
+  return buf;
+}
+
+// A parameter value as the analyst wrote it, in YAML flow style.
+std::string value_text(const host::Value& v) {
+  switch (v.kind) {
+    case host::Value::Kind::Null: return "~";
+    case host::Value::Kind::Scalar: return v.scalar;
+    case host::Value::Kind::List: {
+      std::string s = "[";
+      for (size_t i = 0; i < v.items.size(); ++i) s += (i ? ", " : "") + value_text(v.items[i]);
+      return s + "]";
+    }
+    case host::Value::Kind::Map: {
+      std::string s = "{";
+      for (size_t i = 0; i < v.entries.size(); ++i)
+        s += (i ? ", " : "") + v.entries[i].first + ": " + value_text(v.entries[i].second);
+      return s + "}";
+    }
+  }
+  return {};
+}
+
+const char* kStyle = R"css(
+body { font-family: sans-serif; margin: 24px auto; max-width: 1000px; color: #222; }
+h1 { font-size: 1.5em; margin-bottom: 0.2em; } h2 { border-bottom: 1px solid #ccc; margin-top: 1.6em; }
+.meta { color: #555; font-size: 0.9em; } code { background: #f3f3f3; padding: 1px 3px; }
+table { border-collapse: collapse; margin: 0.6em 0; font-size: 0.88em; }
+td, th { border: 1px solid #ddd; padding: 3px 7px; text-align: left; vertical-align: top; }
+td.n { text-align: right; font-variant-numeric: tabular-nums; }
+.pass { color: #1a7f37; font-weight: bold; } .fail { color: #c62828; font-weight: bold; }
+.chart { margin: 0.8em 0 0.2em 0; min-height: 60px; } .caption { color: #555; font-size: 0.85em; margin-bottom: 1em; }
+.note { color: #555; font-size: 0.88em; }
+)css";
+
+// Inline data as columns instead of row objects (about a third of the size): numbers as one
+// array per field, strings run-length coded. The page's script turns them back into rows.
+void compact_data(json& node) {
+  if (node.is_array()) {
+    for (auto& x : node) compact_data(x);
+    return;
+  }
+  if (!node.is_object()) return;
+  auto d = node.find("data");
+  if (d != node.end() && d->is_object() && d->contains("values") && (*d)["values"].is_array()) {
+    const json& rows = (*d)["values"];
+    json cols = json::object();
+    std::vector<std::string> keys;
+    for (const auto& r : rows)
+      for (auto it = r.begin(); it != r.end(); ++it)
+        if (!cols.contains(it.key())) {
+          cols[it.key()] = json::array();
+          keys.push_back(it.key());
+        }
+    bool ok = !rows.empty();
+    for (const auto& k : keys) {
+      json col = json::array();
+      bool text = false;
+      for (const auto& r : rows) {
+        if (!r.contains(k)) {
+          ok = false;
+          break;
+        }
+        text = text || r[k].is_string();
+        col.push_back(r[k]);
+      }
+      if (!ok) break;
+      if (text) {
+        json rle = json::array();
+        for (const auto& v : col) {
+          if (!rle.empty() && rle.back()[0] == v)
+            rle.back()[1] = rle.back()[1].get<long>() + 1;
+          else
+            rle.push_back(json::array({v, 1}));
+        }
+        cols[k] = {{"rle", rle}};
+      } else {
+        cols[k] = std::move(col);
+      }
+    }
+    if (ok) *d = {{"tf_columns", cols}, {"tf_rows", rows.size()}};
+  }
+  for (auto it = node.begin(); it != node.end(); ++it)
+    if (it.key() != "data") compact_data(it.value());
+}
+
+// The page, chart by chart; charts are rendered by the inlined script at load.
+class Page {
+ public:
+  void html(const std::string& s) { body_ += s; }
+  void chart(const Chart& c) {
+    // A plot with nothing to draw (e.g. errors of a pipeline without truth) becomes a note.
+    if (c.lines + c.areas + c.symbols == 0) {
+      body_ += "<p class=\"note\">" + esc(c.title) + ": no data to plot.</p>\n";
+      return;
+    }
+    const std::string id = "chart-" + std::to_string(charts_.size());
+    body_ += "<div class=\"chart\" id=\"" + id + "\" data-title=\"" + esc(c.title) + "\" data-lines=\"" +
+             std::to_string(c.lines) + "\" data-line-points=\"" + std::to_string(c.line_points) + "\" data-areas=\"" +
+             std::to_string(c.areas) + "\" data-symbols=\"" + std::to_string(c.symbols) + "\"></div>\n";
+    if (!c.caption.empty()) body_ += "<div class=\"caption\">" + esc(c.caption) + "</div>\n";
+    json spec = c.spec;
+    compact_data(spec);
+    charts_.push_back({{"id", id}, {"spec", std::move(spec)}});
+  }
+  std::string finish(const std::string& title) const {
+    std::string specs = charts_.dump();
+    // Inside <script>, "</" could end the element; "<\/" is the same JSON string.
+    for (size_t p = specs.find("</"); p != std::string::npos; p = specs.find("</", p + 3)) specs.replace(p, 2, "<\\/");
+    std::string out;
+    out.reserve(specs.size() + vega_js().size() + vega_lite_js().size() + body_.size() + 4096);
+    out += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>" + esc(title) +
+           "</title>\n<style>" + std::string(kStyle) + "</style>\n</head>\n<body>\n";
+    out += body_;
+    out += "<script id=\"tf-charts\" type=\"application/json\">" + specs + "</script>\n";
+    out += "<script>\n";
+    out += vega_js();
+    out += "\n</script>\n<script>\n";
+    out += vega_lite_js();
+    out += "\n</script>\n<script>\n";
+    out += R"js(// Renders every chart as SVG; data-rendered / data-failed on <body> say when all are done.
+(function () {
+  var charts = JSON.parse(document.getElementById('tf-charts').textContent);
+  // Inline data come as columns ({tf_columns: {x: [...], s: {rle: [[v, n], ...]}}, tf_rows: n}).
+  function rows(data) {
+    var cols = {}, n = data.tf_rows, out = new Array(n);
+    Object.keys(data.tf_columns).forEach(function (k) {
+      var c = data.tf_columns[k];
+      if (c && c.rle) {
+        var full = [];
+        c.rle.forEach(function (r) { for (var i = 0; i < r[1]; i++) full.push(r[0]); });
+        c = full;
+      }
+      cols[k] = c;
+    });
+    for (var i = 0; i < n; i++) {
+      var row = {};
+      for (var k in cols) row[k] = cols[k][i];
+      out[i] = row;
+    }
+    return out;
+  }
+  function expand(node) {
+    if (Array.isArray(node)) { node.forEach(expand); return; }
+    if (!node || typeof node !== 'object') return;
+    if (node.data && node.data.tf_columns) node.data = { values: rows(node.data) };
+    Object.keys(node).forEach(function (k) { if (k !== 'data') expand(node[k]); });
+  }
+  var jobs = charts.map(function (c) {
+    var el = document.getElementById(c.id);
+    try {
+      expand(c.spec);
+      var spec = vegaLite.compile(c.spec).spec;
+      return new vega.View(vega.parse(spec), { renderer: 'svg', container: el, hover: true }).runAsync()
+        .catch(function (e) { el.textContent = 'plot failed: ' + e; throw e; });
+    } catch (e) {
+      el.textContent = 'plot failed: ' + e;
+      return Promise.reject(e);
+    }
+  });
+  Promise.allSettled(jobs).then(function (r) {
+    document.body.setAttribute('data-failed', r.filter(function (x) { return x.status === 'rejected'; }).length);
+    document.body.setAttribute('data-rendered', r.filter(function (x) { return x.status === 'fulfilled'; }).length);
+  });
+})();
+)js";
+    out += "</script>\n</body>\n</html>\n";
+    return out;
+  }
+
+ private:
+  std::string body_;
+  json charts_ = json::array();
+};
+
+std::string header_html(const host::PipelineConfig& c, const std::string& kind, const std::string& command) {
+  std::string h = "<h1>" + esc(c.name) + " &mdash; " + kind + "</h1>\n";
+  if (!c.description.empty()) h += "<p>" + esc(c.description) + "</p>\n";
+  h += "<p class=\"meta\">pipeline file <code>" + esc(c.file) + "</code> &middot; trackflow " + kSdkVersion;
+  if (!command.empty()) h += " &middot; <code>" + esc(command) + "</code>";
+  h += "</p>\n";
+  return h;
+}
+
+void pipeline_section(Page& page, const host::Graph& g, const std::string& hidden) {
+  page.html("<h2>Pipeline</h2>\n");
+  std::vector<GraphNodeView> nodes;
+  std::vector<int> view_index(g.nodes.size(), -1);
+  const auto pos = layout_pipeline(g);
+  for (size_t i = 0; i < g.nodes.size(); ++i) {
+    if (g.nodes[i].config.id == hidden) continue;
+    view_index[i] = static_cast<int>(nodes.size());
+    nodes.push_back({g.nodes[i].config.id, g.nodes[i].config.type, to_string(g.nodes[i].type->decl.kind), pos[i].column,
+                     pos[i].row});
+  }
+  std::vector<GraphEdgeView> edges;
+  for (size_t i = 0; i < g.nodes.size(); ++i) {
+    if (view_index[i] < 0) continue;
+    for (int in : g.nodes[i].inputs)
+      if (view_index[static_cast<size_t>(in)] >= 0) edges.push_back({view_index[static_cast<size_t>(in)], view_index[i], false});
+    if (g.nodes[i].attach_to >= 0) edges.push_back({view_index[i], view_index[static_cast<size_t>(g.nodes[i].attach_to)], true});
+  }
+  page.chart(graph_chart(nodes, edges));
+  page.html("<table><tr><th>node</th><th>type</th><th>kind</th><th>inputs</th><th>parameters (as written)</th></tr>\n");
+  for (const auto& n : g.nodes) {
+    if (n.config.id == hidden) continue;
+    std::string inputs;
+    for (size_t k = 0; k < n.config.inputs.size(); ++k) inputs += (k ? ", " : "") + n.config.inputs[k];
+    if (!n.config.attach_to.empty()) inputs = "attached to " + n.config.attach_to;
+    page.html("<tr><td><b>" + esc(n.config.id) + "</b></td><td><code>" + esc(n.config.type) + "</code></td><td>" +
+              to_string(n.type->decl.kind) + "</td><td>" + esc(inputs) + "</td><td><code>" +
+              esc(n.config.params.kind == host::Value::Kind::Null ? std::string("defaults") : value_text(n.config.params)) +
+              "</code></td></tr>\n");
+  }
+  page.html("</table>\n");
+}
+
+void summary_section(Page& page, const host::Outcome& out, const std::vector<host::ExpectResult>& expects,
+                     unsigned threads, std::uint64_t seed, const std::string& hidden) {
+  page.html("<h2>Summary</h2>\n<p>" + std::to_string(out.runs) + (out.runs == 1 ? " run" : " runs") + ", seed " +
+            std::to_string(seed) + ", " + std::to_string(threads) + (threads == 1 ? " thread" : " threads") + ", " +
+            num(out.seconds) + " s; " + std::to_string(out.measurements_processed) + " measurements processed by " +
+            std::to_string(out.filters) + (out.filters == 1 ? " filter" : " filters") + ".</p>\n");
+  for (const auto& n : out.nodes) {
+    if (n.id == hidden) continue;
+    if (n.summary.metrics.empty() && n.summary.notes.empty() && n.skips == 0) continue;
+    page.html("<h3>" + esc(n.id) + " <small>(" + esc(n.type) + ")</small></h3>\n");
+    if (!n.summary.metrics.empty()) {
+      page.html("<table><tr><th>metric</th><th>value</th><th>unit</th><th>band</th><th></th></tr>\n");
+      for (const auto& m : n.summary.metrics) {
+        std::string band, verdict;
+        if (m.has_band) {
+          band = num(m.confidence * 100) + " % [" + num(m.band_lo) + ", " + num(m.band_hi) + "]";
+          const bool in = m.value >= m.band_lo && m.value <= m.band_hi;
+          verdict = in ? "<span class=\"pass\">inside</span>" : "<span class=\"fail\">outside</span>";
+        }
+        page.html("<tr><td>" + esc(m.name) + "</td><td class=\"n\">" + num(m.value) + "</td><td>" + esc(m.unit) +
+                  "</td><td>" + band + "</td><td>" + verdict + "</td></tr>\n");
+      }
+      page.html("</table>\n");
+    }
+    if (n.skips) page.html("<p class=\"note\">skipped: " + std::to_string(n.skips) + "</p>\n");
+    for (const auto& s : n.summary.notes) page.html("<p class=\"note\">" + esc(s) + "</p>\n");
+  }
+  for (const auto& w : out.warnings) page.html("<p class=\"note\">warning: " + esc(w) + "</p>\n");
+  if (!expects.empty()) {
+    page.html("<h3>expect</h3>\n<table><tr><th></th><th>check</th><th>where</th></tr>\n");
+    size_t failed = 0;
+    for (const auto& e : expects) {
+      failed += e.passed ? 0 : 1;
+      page.html(std::string("<tr><td>") + (e.passed ? "<span class=\"pass\">pass</span>" : "<span class=\"fail\">FAIL</span>") +
+                "</td><td>" + esc(e.text) + "</td><td><code>" + esc(e.expect.loc.str()) + "</code></td></tr>\n");
+    }
+    page.html("</table>\n<p>" + std::to_string(expects.size() - failed) + " passed, " + std::to_string(failed) +
+              " failed</p>\n");
+  }
+}
+
+// A column of a series as a Line against another column (time by default).
+Line column_line(const Series& s, const std::string& column, const std::string& label, const std::string& x = "time") {
+  Line l;
+  l.label = label;
+  const int cx = s.column(x), cy = s.column(column);
+  if (cx < 0 || cy < 0) return l;
+  l.x.reserve(s.rows());
+  l.y.reserve(s.rows());
+  for (size_t r = 0; r < s.rows(); ++r) {
+    l.x.push_back(s.at(r, static_cast<size_t>(cx)));
+    l.y.push_back(s.at(r, static_cast<size_t>(cy)));
+  }
+  return l;
+}
+
+bool has_values(const Line& l) {
+  for (size_t i = 0; i < l.x.size(); ++i)
+    if (std::isfinite(l.x[i]) && std::isfinite(l.y[i])) return true;
+  return false;
+}
+
+// A scoring node's series and what it scores, from the graph's wiring.
+struct Scored {
+  const host::NodeOutcome* node;
+  const Series* series;
+  std::string filter;       // the estimate input
+  std::string measurement;  // the measurement input ("" none)
+};
+
+std::vector<Scored> scored_series(const host::Graph& g, const host::Outcome& out) {
+  std::vector<Scored> v;
+  for (size_t i = 0; i < out.nodes.size() && i < g.nodes.size(); ++i)
+    for (const auto& s : out.nodes[i].summary.series) {
+      if (s.name != "ensemble" || s.column("position_rmse") < 0) continue;
+      Scored sc{&out.nodes[i], &s, out.nodes[i].id, {}};
+      const auto& gn = g.nodes[i];
+      for (size_t k = 0; k < gn.inputs.size(); ++k) {
+        const auto& up = g.nodes[static_cast<size_t>(gn.inputs[k])].config.id;
+        if (gn.input_kinds[k] & mask(ItemKind::Estimate)) sc.filter = up;
+        if ((gn.input_kinds[k] & mask(ItemKind::Measurement)) && sc.measurement.empty()) sc.measurement = up;
+      }
+      v.push_back(sc);
+    }
+  return v;
+}
+
+std::string label_for(const Scored& s, const std::vector<Scored>& all) {
+  int same = 0;
+  for (const auto& o : all) same += o.filter == s.filter ? 1 : 0;
+  return same > 1 ? s.filter + " (" + s.node->id + ")" : s.filter;
+}
+
+void error_section(Page& page, const std::vector<Scored>& scored) {
+  if (scored.empty()) return;
+  page.html("<h2>Error against time</h2>\n<p class=\"note\">Ensemble over the runs, per time step (after each scoring "
+            "node's skip_initial). The measurement RMSE is that of the converted measurements the scoring node "
+            "received.</p>\n");
+  std::vector<Line> pos, vel;
+  std::set<std::string> measured;
+  for (const auto& s : scored) {
+    const std::string label = label_for(s, scored);
+    pos.push_back(column_line(*s.series, "position_rmse", label));
+    vel.push_back(column_line(*s.series, "velocity_rmse", label));
+  }
+  for (const auto& s : scored) {
+    if (s.measurement.empty() || !measured.insert(s.measurement).second) continue;
+    Line m = column_line(*s.series, "measurement_rmse", s.measurement + " (measurements)");
+    if (has_values(m)) pos.push_back(std::move(m));
+  }
+  Chart c = line_chart("position RMSE against time", "time [s]", "position RMSE [m]", pos, true);
+  c.caption = "one line per filter and per measurement stream; log scale; drag to pan, wheel to zoom";
+  page.chart(c);
+  page.chart(line_chart("velocity RMSE against time", "time [s]", "velocity RMSE [m/s]", vel, true));
+  for (const auto& s : scored) {
+    std::vector<Line> bias;
+    for (const char* a : {"x", "y", "z"})
+      bias.push_back(column_line(*s.series, std::string("mean_error_") + a, std::string("mean error ") + a));
+    page.chart(line_chart("mean position error per axis - " + label_for(s, scored), "time [s]", "mean error [m]", bias));
+  }
+}
+
+void consistency_section(Page& page, const std::vector<Scored>& scored) {
+  bool any = false;
+  for (const auto& s : scored) {
+    const std::string label = label_for(s, scored);
+    for (const char* m : {"anees", "anis"}) {
+      Line value = column_line(*s.series, m, std::string(m == std::string("anees") ? "ANEES " : "ANIS ") + label);
+      if (!has_values(value)) continue;
+      if (!any) {
+        page.html("<h2>Consistency against time</h2>\n<p class=\"note\">Per step: average NEES over the runs / 6 "
+                  "(ANEES), average NIS / innovation dimension (ANIS), with the two-sided chi-square band for the "
+                  "number of runs at that step. A consistent filter stays inside the band at about its confidence.</p>\n");
+        any = true;
+      }
+      const Line lo = column_line(*s.series, std::string(m) + "_band_lo", "band");
+      const Line hi = column_line(*s.series, std::string(m) + "_band_hi", "band");
+      size_t in = 0, n = 0;
+      for (size_t i = 0; i < value.y.size(); ++i)
+        if (std::isfinite(value.y[i]) && std::isfinite(lo.y[i]) && std::isfinite(hi.y[i])) {
+          ++n;
+          in += value.y[i] >= lo.y[i] && value.y[i] <= hi.y[i] ? 1 : 0;
+        }
+      Chart c = band_chart(std::string(m == std::string("anees") ? "ANEES" : "ANIS") + " against time - " + label,
+                           m == std::string("anees") ? "ANEES" : "ANIS", value, lo, hi, "chi-square band");
+      c.caption = "shaded: chi-square band for the runs at each step; inside at " +
+                  num(n ? 100.0 * static_cast<double>(in) / static_cast<double>(n) : 0.0) + " % of " +
+                  std::to_string(n) + " steps";
+      page.chart(c);
+    }
+  }
+}
+
+void annotation_section(Page& page, const std::vector<Scored>& scored) {
+  bool header = false;
+  for (const auto& s : scored) {
+    std::vector<Line> lines;
+    for (const auto& col : s.series->columns) {
+      const std::string& n = col.name;
+      if (n.size() > 5 && n.compare(n.size() - 5, 5, "_mean") == 0) lines.push_back(column_line(*s.series, n, n.substr(0, n.size() - 5)));
+    }
+    std::vector<Line> fractions = {column_line(*s.series, "initialised_fraction", "initialised"),
+                                   column_line(*s.series, "updated_fraction", "updated")};
+    if (!header) {
+      page.html("<h2>Filter state and adapter annotations against time</h2>\n");
+      header = true;
+    }
+    const std::string label = label_for(s, scored);
+    page.chart(line_chart("fraction of runs initialised and updated - " + label, "time [s]", "fraction of runs", fractions));
+    if (!lines.empty()) {
+      Chart c = line_chart("adapter annotations (mean over runs) - " + label, "time [s]", "mean value", lines);
+      c.caption = "per channel: mean over the runs of the value the adapters attached to the estimate "
+                  "(<adapter>.grade_*: quality grades, 0 best, 1 normal, 2 worst; <adapter>.sigma_*: adapted R, m)";
+      page.chart(c);
+    }
+  }
+}
+
+void track_section(Page& page, const host::Graph& g, const host::Outcome& out, const std::string& track_node,
+                   std::uint64_t run) {
+  const host::NodeOutcome* t = out.find(track_node);
+  if (!t || t->summary.series.empty()) return;
+  // Measurements drawn are those the filters received (the others are the same points before conversion).
+  std::set<std::string> fed;
+  for (const auto& n : g.nodes)
+    if (n.type->decl.kind == ComponentKind::Filter)
+      for (int in : n.inputs) fed.insert(g.nodes[static_cast<size_t>(in)].config.id);
+  std::vector<Line> ground_paths, ground_points, alt_paths, alt_points;
+  for (const auto& s : t->summary.series) {
+    const auto colon = s.name.find(':');
+    const std::string kind = s.name.substr(0, colon), node = s.name.substr(colon + 1);
+    if (kind == "measurement" && !fed.empty() && !fed.count(node)) continue;
+    const std::string label = kind == "truth"         ? (node == "truth" ? node : node + " (truth)")
+                              : kind == "measurement" ? node + " (measurements)"
+                                                      : node;
+    Line ground = column_line(s, "y", label, "x");
+    Line alt = column_line(s, "z", label);
+    if (kind == "measurement") {
+      ground_points.push_back(std::move(ground));
+      alt_points.push_back(std::move(alt));
+    } else {
+      ground_paths.push_back(std::move(ground));
+      alt_paths.push_back(std::move(alt));
+    }
+  }
+  page.html("<h2>Track of run " + std::to_string(run) + "</h2>\n<p class=\"note\">Truth, the measurements the filters "
+            "received (converted to the ENU frame) and each filter's estimates, for one run (<code>--track-run</code>). "
+            "The radar is at the origin.</p>\n");
+  page.chart(track_chart("ground track (east-north)", "east x [m]", "north y [m]", ground_paths, ground_points, true));
+  page.chart(track_chart("altitude against time", "time [s]", "up z [m]", alt_paths, alt_points, false));
+}
+
+// Series of per-interval RMSE (sink.interval_rmse): the filter against the measurements.
+void interval_section(Page& page, const host::Graph& g, const host::Outcome& out) {
+  bool header = false;
+  for (size_t i = 0; i < out.nodes.size() && i < g.nodes.size(); ++i)
+    for (const auto& s : out.nodes[i].summary.series) {
+      if (s.name != "intervals" || s.column("filter_rmse") < 0) continue;
+      if (!header) {
+        page.html("<h2>RMSE per interval</h2>\n");
+        header = true;
+      }
+      std::vector<Line> lines = {column_line(s, "filter_rmse", "filter", "interval_start"),
+                                 column_line(s, "measurement_rmse", "measurements", "interval_start")};
+      Chart c = line_chart("position RMSE per interval - " + out.nodes[i].id, "interval start [s]", "position RMSE [m]",
+                           lines, true);
+      c.spec["mark"]["point"] = true;
+      c.symbols = c.line_points;  // a symbol on every point
+      page.chart(c);
+    }
+}
+
+void files_section(Page& page, const std::vector<std::string>& files) {
+  if (files.empty()) return;
+  page.html("<h2>Files</h2>\n<p class=\"note\">The numbers behind the plots, at full precision and every step "
+            "(units in the column names):</p>\n<ul>\n");
+  for (const auto& f : files) page.html("<li><code>" + esc(f) + "</code></li>\n");
+  page.html("</ul>\n");
+}
+
+}  // namespace
+
+std::string render_run_report(const RunReport& r) {
+  const host::Graph& g = *r.graph;
+  const host::Outcome& out = *r.outcome;
+  Page page;
+  page.html(header_html(g.config, "run report", r.command));
+  pipeline_section(page, g, r.track_node);
+  static const std::vector<host::ExpectResult> none;
+  summary_section(page, out, r.expects ? *r.expects : none, r.threads, g.config.seed, r.track_node);
+  const auto scored = scored_series(g, out);
+  error_section(page, scored);
+  consistency_section(page, scored);
+  if (!r.track_node.empty()) track_section(page, g, out, r.track_node, r.track_run);
+  annotation_section(page, scored);
+  interval_section(page, g, out);
+  files_section(page, r.files);
+  return page.finish(g.config.name + " - trackflow report");
+}
+
+std::string render_sweep_report(const SweepReport& r) {
+  const host::Graph& g = *r.graph;
+  Page page;
+  page.html(header_html(g.config, "sweep report", r.command));
+  pipeline_section(page, g, {});
+  const size_t points = r.metrics.empty() ? 0 : r.metrics.front().value.size();
+  page.html("<h2>Sweep</h2>\n<p>" + std::to_string(points) + " grid points, " + std::to_string(r.runs) +
+            " runs each, the same seed at every point (common random numbers).</p>\n");
+  // The metric against the first numeric axis; one line per combination of the other axes.
+  int x_axis = -1;
+  for (size_t a = 0; a < r.axes.size() && x_axis < 0; ++a)
+    if (std::all_of(r.axes[a].value.begin(), r.axes[a].value.end(), [](double v) { return std::isfinite(v); }))
+      x_axis = static_cast<int>(a);
+  if (x_axis >= 0) {
+    const auto& ax = r.axes[static_cast<size_t>(x_axis)];
+    bool log_x = true;
+    double lo = INFINITY, hi = 0;
+    for (double v : ax.value) {
+      log_x = log_x && v > 0;
+      lo = std::min(lo, v);
+      hi = std::max(hi, v);
+    }
+    log_x = log_x && hi / lo >= 100;
+    for (const auto& m : r.metrics) {
+      std::map<std::string, Line> by_rest;
+      std::vector<std::string> order;
+      for (size_t p = 0; p < m.value.size(); ++p) {
+        std::string rest;
+        for (size_t a = 0; a < r.axes.size(); ++a)
+          if (static_cast<int>(a) != x_axis) rest += (rest.empty() ? "" : ", ") + r.axes[a].name + "=" + r.axes[a].text[p];
+        if (rest.empty()) rest = m.name;
+        if (!by_rest.count(rest)) order.push_back(rest);
+        Line& l = by_rest[rest];
+        l.label = rest;
+        l.x.push_back(ax.value[p]);
+        l.y.push_back(m.value[p]);
+      }
+      std::vector<Line> lines;
+      for (const auto& k : order) lines.push_back(by_rest[k]);
+      const std::string xt = ax.name + (ax.unit.empty() ? "" : " [" + ax.unit + "]");
+      const std::string yt = m.name + (m.unit.empty() ? "" : " [" + m.unit + "]");
+      Chart c = line_chart(m.name + " against " + ax.name, xt, yt, lines);
+      if (log_x) c.spec["encoding"]["x"]["scale"] = {{"type", "log"}};
+      c.spec["mark"]["point"] = true;
+      c.symbols = c.line_points;  // a symbol on every point
+      c.caption = log_x ? "log scale on x" : "";
+      page.chart(c);
+    }
+  } else {
+    page.html("<p class=\"note\">No axis has numeric values only: see the table.</p>\n");
+  }
+  page.html("<table><tr>");
+  for (const auto& a : r.axes) page.html("<th>" + esc(a.name) + (a.unit.empty() ? "" : " [" + esc(a.unit) + "]") + "</th>");
+  for (const auto& m : r.metrics) page.html("<th>" + esc(m.name) + (m.unit.empty() ? "" : " [" + esc(m.unit) + "]") + "</th>");
+  page.html("</tr>\n");
+  for (size_t p = 0; p < points; ++p) {
+    page.html("<tr>");
+    for (const auto& a : r.axes) page.html("<td class=\"n\">" + esc(a.text[p]) + "</td>");
+    for (const auto& m : r.metrics) page.html("<td class=\"n\">" + num(m.value[p]) + "</td>");
+    page.html("</tr>\n");
+  }
+  page.html("</table>\n");
+  files_section(page, r.files);
+  return page.finish(g.config.name + " - trackflow sweep report");
+}
+
+void write_text_file(const std::string& path, const std::string& text) {
+  const auto parent = std::filesystem::path(path).parent_path();
+  std::error_code ec;
+  if (!parent.empty()) std::filesystem::create_directories(parent, ec);
+  std::ofstream f(path, std::ios::binary | std::ios::trunc);
+  f << text;
+  f.flush();
+  if (!f) throw ConfigError("cannot write '" + path + "': " + std::strerror(errno));
+}
+
+}  // namespace trackflow::report
