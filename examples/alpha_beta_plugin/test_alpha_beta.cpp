@@ -1,10 +1,8 @@
 // Purpose: tests of filter.alpha_beta: gains and covariance against the Kalman Riccati recursion, the recursion by hand, Monte Carlo consistency, errors.
 #include "alpha_beta_gains.hpp"
 
-#include <trackflow/host/config.hpp>
-#include <trackflow/host/plugins.hpp>
-#include <trackflow/host/validate.hpp>
 #include <trackflow/rng.hpp>
+#include <trackflow/testing/plugin_fixture.hpp>
 
 #include <catch2/catch.hpp>
 
@@ -19,33 +17,18 @@ using namespace trackflow;
 
 namespace {
 
-// The plugin is loaded through the same host code `trackflow run` uses, from the file just built.
-const host::PluginRegistry& registry() {
-  static const host::PluginRegistry reg = [] {
-    host::PluginRegistry r;
-    r.load_file(ALPHA_BETA_PLUGIN_FILE);
-    for (const auto& p : r.problems()) FAIL("plugin not loaded: " << p.str());
-    return r;
-  }();
-  return reg;
+// The plugins are loaded through the same host code `trackflow run` uses, from the files just
+// built, by the fixture installed with the SDK (trackflow/testing/plugin_fixture.hpp).
+const testing::PluginFixture& fixture() {
+  static const testing::PluginFixture f({ALPHA_BETA_PLUGIN_FILE, FADING_MEMORY_PLUGIN_FILE});
+  return f;
 }
 
 std::shared_ptr<Component> make(const std::string& yaml_params, const std::string& node = "ab") {
-  const host::RegisteredType* t = registry().find("filter.alpha_beta");
-  REQUIRE(t != nullptr);
-  const host::Value v = host::load_yaml_string(yaml_params, "test params");
-  return registry().create(*t, host::validate_params(t->decl.params, v, node, v.loc));
+  return fixture().make("filter.alpha_beta", yaml_params, node);
 }
 
-struct Collector : Component {
-  void on_estimate(const Estimate& e, int) override { estimates.push_back(e); }
-  void attach_to(Component& c) {
-    link = {this, 0, 0xFF};
-    c.out.connect(&link, 1);
-  }
-  std::vector<Estimate> estimates;
-  Link link;
-};
+using testing::Collector;
 
 Measurement cartesian(double t, const Vec3& z, const Vec3& variance) {
   Measurement m;
@@ -318,4 +301,37 @@ TEST_CASE("non-positive time step skips update and invalid coasts") {
   CHECK(e.enu(0) == Approx(4.0));  // 2 m + 1 s × 2 m/s
   CHECK(e.enu_covariance(0, 0) > out.estimates[1].enu_covariance(0, 0));
   CHECK(e.enu_covariance.allFinite());
+}
+
+// The example adapter rescales the filter's P through the SDK's covariance handle.
+TEST_CASE("fading memory scales P by alpha squared before each update") {
+  auto f = make("{}", "ab");
+  auto a = fixture().make("adapt.fading_memory", "{ alpha: 2 }", "fm");
+  auto& filter = dynamic_cast<Filter&>(*f);
+  auto& adapter = dynamic_cast<Adapter&>(*a);
+  testing::attach(adapter, filter);
+  Collector out;
+  out.attach_to(*f);
+  Diagnostics diag;
+  testing::start_run(*f, 0, 1, &diag);
+  a->start_run({0, 1, &diag});
+  f->on_measurement(cartesian(0.0, Vec3(0, 0, 0), Vec3::Ones()), 0);
+  f->on_measurement(cartesian(1.0, Vec3(1, 0, 0), Vec3::Ones()), 0);
+  StateCov before;
+  filter.read_covariance(before);
+  REQUIRE(before.rows() == 6);
+  adapter.before_update(cartesian(2.0, Vec3(2, 0, 0), Vec3::Ones()), filter);
+  StateCov after;
+  filter.read_covariance(after);  // the current P, rescaled by alpha^2 = 4
+  CHECK(after(0, 0) == Approx(4.0 * before(0, 0)));
+  CHECK(after(1, 3) == Approx(4.0 * before(1, 3)));
+  f->on_measurement(cartesian(2.0, Vec3(2, 0, 0), Vec3::Ones()), 0);
+  // The adapter ran again inside that step: its annotation is the rescaled position variance.
+  REQUIRE(out.estimates.back().annotation_count == 1);
+  CHECK(out.estimates.back().annotations[0] == Approx(16.0 * before(0, 0)));
+  // An adapter whose needs the filter cannot meet is refused, naming why.
+  struct WantsR : Adapter {
+    NoiseNeeds needs() const override { return {MeasurementSpace::Spherical}; }
+  } wants_spherical_r;
+  CHECK_THROWS_WITH(testing::attach(wants_spherical_r, filter), Catch::Contains("spherical"));
 }

@@ -181,7 +181,7 @@ class BOOST_SYMBOL_VISIBLE Filter : public Component {
   // State covariance for adapters (fading memory, inflation, re-initialisation). A filter that
   // returns true from has_covariance_access implements the three below.
   virtual bool has_covariance_access() const { return false; }
-  // The covariance of the state as published (state_layout order); empty before initialisation.
+  // The current covariance of the state (state_layout order); empty before initialisation.
   virtual void read_covariance(StateCov& P) const { P.resize(0, 0); }
   // P <- factor P (factor > 0), whatever the filter's internal representation of P.
   virtual void scale_covariance(double /*factor*/) {}

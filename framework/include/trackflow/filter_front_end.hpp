@@ -139,14 +139,21 @@ class FilterFrontEnd : public Filter {
 
   bool initialised() const { return initialised_; }
 
-  // Covariance access for adapters, the same for every filter: the covariance as last published,
-  // a rescale that the filter applies to whatever representation of P it keeps, a restart.
+  // Covariance access for adapters, the same for every filter: the current state covariance (in
+  // state_layout() order), a rescale that the filter applies to whatever representation of P it
+  // keeps, a restart.
   bool has_covariance_access() const final { return true; }
   void read_covariance(StateCov& P) const final {
-    if (initialised_)
-      P = est_.covariance;
-    else
+    if (!initialised_) {
       P.resize(0, 0);
+      return;
+    }
+    // fill_estimate may cache intermediate products in the filter: the filter, not the state,
+    // changes, so the const of this read is kept for callers.
+    scratch_.state.resize(est_.state.size());  // fixed capacity: no heap
+    scratch_.covariance.resize(est_.covariance.rows(), est_.covariance.cols());
+    const_cast<FilterFrontEnd*>(this)->derived().fill_estimate(scratch_);
+    P = scratch_.covariance;
   }
   void scale_covariance(double factor) final {
     if (initialised_ && factor > 0.0 && factor < std::numeric_limits<double>::infinity())
@@ -231,6 +238,7 @@ class FilterFrontEnd : public Filter {
   double time_ = 0.0;
   bool has_time_ = false, initialised_ = false, non_finite_reported_ = false;
   FrontEndRunResult run_, total_;
+  mutable Estimate scratch_;  // read_covariance's, so the published estimate is never touched
 };
 
 }  // namespace trackflow
