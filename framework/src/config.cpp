@@ -304,17 +304,23 @@ PipelineConfig parse_pipeline(const Value& root, const std::string& file, const 
     if (ex->kind != Value::Kind::Map) throw ConfigError("'expect' must be a map of <node>.<metric>: {check}", ex->loc);
     for (size_t i = 0; i < ex->entries.size(); ++i) {
       const auto& [key, val] = ex->entries[i];
-      // { min: a, max: b } is two checks.
-      if (val.kind == Value::Kind::Map && val.find("min") && val.find("max")) {
-        for (const char* op : {"min", "max"}) {
+      // { min: a, max: b, less_than: x.y } is one check per comparison, each checked (tolerance goes
+      // with equals, ratio_to with min and max).
+      int comparisons = 0;
+      if (val.kind == Value::Kind::Map)
+        for (const auto& [op, unused] : val.entries) comparisons += op != "tolerance" && op != "ratio_to";
+      if (comparisons > 1) {
+        for (const auto& [op, opval] : val.entries) {
+          if (op == "tolerance" || op == "ratio_to") continue;
           Value one;
           one.kind = Value::Kind::Map;
           one.loc = val.loc;
-          one.entries.emplace_back(op, *val.find(op));
+          one.entries.emplace_back(op, opval);
           one.key_locs.push_back(val.key_loc(op));
-          if (const Value* r = val.find("ratio_to")) {
-            one.entries.emplace_back("ratio_to", *r);
-            one.key_locs.push_back(val.key_loc("ratio_to"));
+          const char* companion = op == "equals" ? "tolerance" : (op == "min" || op == "max") ? "ratio_to" : nullptr;
+          if (const Value* c = companion ? val.find(companion) : nullptr) {
+            one.entries.emplace_back(companion, *c);
+            one.key_locs.push_back(val.key_loc(companion));
           }
           cfg.expects.push_back(parse_expect(key, ex->key_locs[i], one));
         }

@@ -1,4 +1,5 @@
 // Purpose: adapt.innovation_r — retunes a filter's Cartesian measurement noise R from its post-update residuals (paper 001 eq 28-32).
+#include "difference_noise_factor.hpp"
 #include "residual_r_estimator.hpp"
 
 #include <trackflow/plugin.hpp>
@@ -15,6 +16,7 @@ using adapt::ResidualREstimator;
 
 enum class PostFitTerm { Add, Subtract };
 enum class Covariance { FollowR, Keep };
+enum class WarmupEstimate { SecondDifferences, Nominal };
 
 // The end-of-run state of one run; the aggregating instance sums these in run order.
 struct InnovationRRunResult final : RunResult {
@@ -38,7 +40,8 @@ double noise_factor(const ResidualREstimator& e) {
 
 class InnovationRAdapter final : public Adapter {
  public:
-  InnovationRAdapter(adapt::EstimatorSettings s, bool follow_r) : settings_(s), estimator_(s), follow_r_(follow_r) {}
+  InnovationRAdapter(adapt::EstimatorSettings s, bool follow_r, bool warmup_differences)
+      : settings_(s), estimator_(s), follow_r_(follow_r), warmup_differences_(warmup_differences) {}
 
   NoiseNeeds needs() const override {
     NoiseNeeds n;
@@ -55,23 +58,38 @@ class InnovationRAdapter final : public Adapter {
     updates_ = floored_ = run_factor_count_ = rescales_ = 0;
     run_factor_sum_ = 0.0;
     applied_variance_factor_ = 1.0;
+    differences_.reset();
   }
 
   void before_update(const Measurement& m, Filter& f) override {
-    if (m.covariance.rows() < 3 || m.covariance.cols() < 3) return;
-    const Mat3 nominal = m.covariance.topLeftCorner<3, 3>();
-    if (!estimator_.started()) {
-      if (!nominal.allFinite()) return;
-      estimator_.start(nominal);
+    // An invalid measurement is only coasted through (and may not even be converted).
+    if (!m.valid || m.covariance.rows() < 3 || m.covariance.cols() < 3 || m.value.size() < 3) {
+      differences_.gap();
+      return;
     }
-    if (!estimator_.adapting()) return;  // warm-up: the filter keeps the measurement's own R
+    const Mat3 nominal = m.covariance.topLeftCorner<3, 3>();
+    if (!nominal.allFinite() || !m.value.head<3>().allFinite()) return;
+    if (!estimator_.started()) estimator_.start(nominal);
     MeasCov* R = f.noise().measurement.R;
+    if (!estimator_.adapting()) {
+      // Warm-up: the residuals still carry the start-up state error. The measurements' own R,
+      // scaled by the second-difference noise factor once it has enough samples (warmup_estimate:
+      // second_differences), or as it is (nominal).
+      if (!warmup_differences_) return;
+      differences_.add(m.time, m.value.head<3>(), nominal);
+      const double k2 = differences_.variance_factor();
+      if (differences_.samples() < kMinDifferences || !std::isfinite(k2) || !(k2 > 0.0)) return;
+      estimator_.set_warmup_scale(k2);
+      if (R && R->rows() >= 3 && R->cols() >= 3) R->topLeftCorner<3, 3>() = k2 * nominal;
+      if (follow_r_) follow(f, k2);
+      return;
+    }
     if (R) *R = estimator_.estimate();
-    if (follow_r_) follow(f);
+    if (follow_r_) follow(f, noise_factor(estimator_) * noise_factor(estimator_));
   }
 
   void after_update(const Measurement& m, const Estimate& e, Filter& f) override {
-    if (estimator_.adapting())
+    if (estimator_.started())
       for (int i = 0; i < 3; ++i) annotate(f, i, std::sqrt(std::max(0.0, estimator_.estimate()(i, i))));
     if (!e.updated || !e.initialised || !m.valid || !estimator_.started() || m.value.size() < 3) return;
     const Vec3 residual = m.value.head<3>() - e.enu.head<3>();
@@ -161,10 +179,8 @@ class InnovationRAdapter final : public Adapter {
   // by the change of k^2 = tr(R_nom^-1 R-hat)/3 since the last step, so over a run it has followed
   // R-hat's growth once; the filter's own updates then settle it. Without this the gains
   // collapse when R-hat grows while P still claims the small start-up error.
-  void follow(Filter& f) {
-    const double k = noise_factor(estimator_);
-    if (!std::isfinite(k) || !(k > 0.0)) return;
-    const double variance_factor = k * k;
+  void follow(Filter& f, double variance_factor) {
+    if (!std::isfinite(variance_factor) || !(variance_factor > 0.0)) return;
     const double step = variance_factor / applied_variance_factor_;
     if (std::abs(step - 1.0) < 1e-12) return;
     f.scale_covariance(step);
@@ -175,6 +191,11 @@ class InnovationRAdapter final : public Adapter {
   adapt::EstimatorSettings settings_;
   ResidualREstimator estimator_;
   bool follow_r_ = true;
+  bool warmup_differences_ = true;
+  adapt::DifferenceNoiseFactor differences_;
+  // Second differences before their noise factor is used: the estimate of k² from n of them has
+  // a relative spread of about sqrt(2 / (3 n)) (0.37 at 5).
+  static constexpr int kMinDifferences = 1;
   double applied_variance_factor_ = 1.0;
   std::uint64_t rescales_ = 0, rescales_total_ = 0;
   double variance_factor_sum_ = 0.0;
@@ -194,7 +215,9 @@ const char* const kDoc =
     "R_k = R_{k-1} + (R_s - R_{k-1}) / L (eq 31), symmetrised (eq 32), then floored. Before each update R_k is "
     "written into the filter's R (Filter::noise().measurement_noise), so it is used from the next step on "
     "(eq 25). The first `warmup` residuals are not used (they hold the initial-state error, which the average "
-    "would take for noise; the filter keeps the measurements' own R meanwhile). Sign: for the optimal gain E[dz dz'] = R S^-1 R = R - H P+ H', so '+' is unbiased and positive "
+    "would take for noise); meanwhile R is the measurements' own R times the noise factor squared of their second "
+    "differences z_k - 2 z_k-1 + z_k-2 (covariance R_k + 4 R_k-1 + R_k-2 for any constant-velocity motion; "
+    "warmup_estimate: second_differences, not in the paper) or the measurements' own R as it is (nominal). Sign: for the optimal gain E[dz dz'] = R S^-1 R = R - H P+ H', so '+' is unbiased and positive "
     "definite; eq 28 prints '-' (post_fit_term: subtract reproduces it; it is biased low). Floor: R >= "
     "floor_ratio^2 times the measurement's own R (generalised eigenvalues raised), then every eigenvalue >= "
     "floor_sigma^2. Starts from the first measurement's covariance. Needs a filter exposing R in measurement space "
@@ -233,6 +256,13 @@ void register_components(Registrar& r) {
                                     "rescale the filter's state covariance P as R-hat grows or shrinks (follow_r: by the "
                                     "change of the noise factor squared; not in the paper) or leave P alone (keep)")
           .def("follow_r"),
+      ParamSpec::choice<WarmupEstimate>("warmup_estimate",
+                                        {{WarmupEstimate::SecondDifferences, "second_differences"},
+                                         {WarmupEstimate::Nominal, "nominal"}},
+                                        "R during the warm-up: the measurements' own R times the noise factor squared "
+                                        "from their second differences (no filter state involved; not in the paper), "
+                                        "or the measurements' own R as it is (nominal)")
+          .def("second_differences"),
   };
   d.create = [](const Params& p) {
     adapt::EstimatorSettings s;
@@ -241,7 +271,9 @@ void register_components(Registrar& r) {
     s.floor_sigma = p.real("floor_sigma");
     s.add_posterior = p.choice<PostFitTerm>("post_fit_term") == PostFitTerm::Add;
     s.warmup = static_cast<int>(p.integer("warmup"));
-    return std::make_unique<InnovationRAdapter>(s, p.choice<Covariance>("covariance") == Covariance::FollowR);
+    return std::make_unique<InnovationRAdapter>(s, p.choice<Covariance>("covariance") == Covariance::FollowR,
+                                                p.choice<WarmupEstimate>("warmup_estimate") ==
+                                                    WarmupEstimate::SecondDifferences);
   };
   r.add(std::move(d));
 }

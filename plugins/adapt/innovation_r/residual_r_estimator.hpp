@@ -76,6 +76,10 @@ class ResidualREstimator {
   explicit ResidualREstimator(EstimatorSettings s = {}) : s_(s) {}
 
   bool started() const { return started_; }
+  // During the warm-up R̂ is the measurement's own R times this (an estimate of the noise factor
+  // squared that does not come from residuals; 1: the measurement's own R).
+  void set_warmup_scale(double k2) { warmup_scale_ = k2; }
+  double warmup_scale() const { return warmup_scale_; }
   bool adapting() const { return started_ && seen_ >= s_.warmup; }
   const Mat3& estimate() const { return R_; }
   // The measurements' own R averaged with the same window: what R̂ tends to if the sensor's
@@ -94,8 +98,8 @@ class ResidualREstimator {
   bool update(const Vec3& residual, const Mat3& posterior_position_cov, const Mat3& nominal) {
     if (seen_ < s_.warmup) {
       ++seen_;
-      R_ = 0.5 * (nominal + nominal.transpose());
-      nominal_ = R_;
+      nominal_ = 0.5 * (nominal + nominal.transpose());
+      R_ = warmup_scale_ * nominal_;
       return apply_floor(R_, nominal, s_.floor_ratio, s_.floor_sigma);
     }
     const double w = 1.0 / static_cast<double>(s_.window);
@@ -116,6 +120,7 @@ class ResidualREstimator {
   Mat3 nominal_ = Mat3::Zero();
   bool started_ = false;
   int seen_ = 0;
+  double warmup_scale_ = 1.0;
 };
 
 }  // namespace trackflow::adapt
