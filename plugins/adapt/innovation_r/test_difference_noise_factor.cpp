@@ -32,7 +32,7 @@ DifferenceNoiseFactor measure(int n, double k, const Vec3& sigma, std::uint64_t 
 
 }  // namespace
 
-TEST_CASE("second differences give k2 of a sensor that misreports") {
+TEST_CASE("second differences give k2 of a misreporting sensor") {
   // n pairs of 3-D second differences: k² is a mean of 3n correlated chi-square terms; 4 standard
   // deviations of an independent estimate, 4 sqrt(2 / (3 n)) k², with n = 3000 is 6 % of k²,
   // doubled for the correlation of neighbouring differences.
