@@ -1,11 +1,21 @@
-// Purpose: benchmark: quickstart pipeline vs the same computation as a plain loop, and the 6-state Kalman step.
+// Purpose: benchmark: the quickstart pipeline against the same computation as a plain loop; one 6-state CV Kalman step through filter.kalman, as plain fixed-size Eigen, and in OpenCV's cv::KalmanFilter side by side.
 //
-// Usage: trackflow-bench [--runs N] [--steps N]. Single thread. Prints measurements/s of
-//   (1) the quickstart pipeline through the engine and plugins,
-//   (2) the same simulation, conversion, CV Kalman filter and error/NEES bookkeeping written
-//       as one plain loop over fixed-size Eigen (same SDK math headers),
-//   (3) one Kalman step through the filter.kalman plugin (virtual call, no consumers) and a
-//       plain fixed-size Eigen step, on pre-generated measurements.
+// Usage: trackflow-bench [--runs N] [--reps N] [--rounds R] [--only pipeline|kalman]. Single thread.
+// Every section alternates its contenders for R rounds (default 5) and keeps each one's best
+// round, so other load on a shared machine affects them alike; rates are given per second of
+// CPU time (this process on its core) and of wall time.
+//   pipeline: quickstart through the engine and five plugins (N runs per round, default 400)
+//     against the same simulation, conversion, CV Kalman filter and error/NEES bookkeeping
+//     written as one plain loop over fixed-size Eigen (same SDK math headers).
+//   kalman: 1000 pre-generated Cartesian position measurements, N passes per round (default 400):
+//     filter.kalman through its plugin (virtual call, Estimate formed and read by a consumer),
+//     a plain fixed-size Eigen textbook step, and cv::KalmanFilter (OpenCV, CV_64F) with the same
+//     F, Q, H, R, initial state and covariance — once with a diagonal R (independent axes) and
+//     once with a full R that changes every step (as converted measurements have). The final
+//     states are compared as a check that the three compute the same filter. OpenCV is optional:
+//     without it (Debian libopencv-video-dev) its rows are skipped with a message.
+#include "bench_common.hpp"
+
 #include <trackflow/geometry.hpp>
 #include <trackflow/host/engine.hpp>
 #include <trackflow/host/validate.hpp>
@@ -14,21 +24,25 @@
 #include <trackflow/rng.hpp>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Geometry>
 
-#include <chrono>
+#ifdef TRACKFLOW_BENCH_OPENCV
+#include <opencv2/video/tracking.hpp>
+#endif
+
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <string>
 #include <vector>
 
 using namespace trackflow;
-using Clock = std::chrono::steady_clock;
+using namespace trackflow::bench;
 
 namespace {
 
-double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
-
-// (2) The quickstart computation without the framework. Same parameters as pipelines/quickstart.yaml.
+// The quickstart computation without the framework. Same parameters as pipelines/quickstart.yaml.
+// Returns the number of measurements processed.
 double plain_loop(int runs, double& checksum) {
   using M = ConstantVelocity;
   const double T = 0.1, q = 0.001, sr = 10.0, sa = 1e-3, se = 1e-3;
@@ -40,7 +54,6 @@ double plain_loop(int runs, double& checksum) {
   Eigen::Matrix<double, 3, 6> H = Eigen::Matrix<double, 3, 6>::Zero();
   for (int a = 0; a < 3; ++a) H(a, M::position_index(a)) = 1;
   std::vector<double> sq_err(steps), nees(steps), meas_sq(steps);
-  const auto t0 = Clock::now();
   for (int run = 0; run < runs; ++run) {
     Rng rng(derive_seed(1, run, "radar"));
     M::State x;
@@ -97,109 +110,253 @@ double plain_loop(int runs, double& checksum) {
       nees[k] += e.dot(C.ldlt().solve(e));
     }
   }
-  const double secs = seconds_since(t0);
   double sum = 0, ne = 0;
   for (int k = 1; k < steps; ++k) {
     sum += sq_err[k];
     ne += nees[k];
   }
-  checksum = std::sqrt(sum / ((steps - 1.0) * runs)) + ne / ((steps - 1.0) * runs * 6);
-  return static_cast<double>(runs) * steps / secs;
+  checksum += std::sqrt(sum / ((steps - 1.0) * runs)) + ne / ((steps - 1.0) * runs * 6);
+  return static_cast<double>(runs) * steps;
 }
 
-std::vector<Measurement> cv_measurements(int n) {
+// The Kalman step benchmark's problem: CV target, 10 Hz, explicit initial state, q = 1 m2/s3.
+constexpr double kT = 0.1, kQ = 1.0;
+const double kX0[6] = {1000, 10, 2000, 0, 300, 0};  // [x vx y vy z vz]
+constexpr double kSigmaP0 = 50.0, kSigmaV0 = 20.0;
+
+// 1000 measurements of a CV target; `full_R`: each with its own correlated R (a rotated diagonal,
+// like a converted radar measurement's), else R = 25 m2 I.
+std::vector<Measurement> cv_measurements(int n, bool full_R) {
   std::vector<Measurement> ms(n);
   Rng rng(5);
   for (int k = 0; k < n; ++k) {
     auto& m = ms[k];
-    m.time = 0.1 * k;
+    m.time = kT * k;
     m.frame = Frame::Cartesian;
-    m.value = Vec3(1000 + 10 * m.time + 5 * rng.normal(), 2000 + 5 * rng.normal(), 300 + 5 * rng.normal());
-    m.covariance = MeasCov::Identity(3, 3) * 25.0;
+    Mat3 R = Mat3::Identity() * 25.0;
+    if (full_R) {
+      const double a = 0.3 + 0.001 * k, b = 0.2;
+      const Mat3 U = (Eigen::AngleAxisd(a, Vec3::UnitZ()) * Eigen::AngleAxisd(b, Vec3::UnitX())).toRotationMatrix();
+      R = U * Vec3(25.0, 400.0, 100.0).asDiagonal() * U.transpose();
+      R = (0.5 * (R + R.transpose())).eval();
+    }
+    const Eigen::LLT<Mat3> llt(R);
+    const Vec3 w(rng.normal(), rng.normal(), rng.normal());
+    m.value = Vec3(Vec3(1000 + 10 * m.time, 2000, 300) + llt.matrixL() * w);
+    m.covariance = R;
   }
   return ms;
 }
 
-// (3b) The plain fixed-size Eigen Kalman step the brief quotes (~0.3 us on this box).
-double plain_kalman_steps(const std::vector<Measurement>& ms, int reps, double& checksum) {
-  using M = ConstantVelocity;
-  M::Matrix F, Q;
-  M::transition(0.1, F);
-  M::block_diagonal(M::axis_noise_continuous(0.1, 1.0), Q);
-  Eigen::Matrix<double, 3, 6> H = Eigen::Matrix<double, 3, 6>::Zero();
-  for (int a = 0; a < 3; ++a) H(a, M::position_index(a)) = 1;
-  const auto t0 = Clock::now();
-  checksum = 0;
+using CvModel = ConstantVelocity;
+
+void model_matrices(CvModel::Matrix& F, CvModel::Matrix& Q, Eigen::Matrix<double, 3, 6>& H, CvModel::State& x0,
+                    CvModel::Matrix& P0) {
+  CvModel::transition(kT, F);
+  CvModel::block_diagonal(CvModel::axis_noise_continuous(kT, kQ), Q);
+  H.setZero();
+  for (int a = 0; a < 3; ++a) H(a, CvModel::position_index(a)) = 1;
+  for (int i = 0; i < 6; ++i) x0(i) = kX0[i];
+  P0.setZero();
+  for (int a = 0; a < 3; ++a) {
+    P0(2 * a, 2 * a) = kSigmaP0 * kSigmaP0;
+    P0(2 * a + 1, 2 * a + 1) = kSigmaV0 * kSigmaV0;
+  }
+}
+
+// filter.kalman through its plugin, `reps` passes.
+void plugin_passes(Component& kf, const std::vector<Measurement>& ms, int reps) {
+  Diagnostics d;
   for (int rep = 0; rep < reps; ++rep) {
-    M::State x = M::State::Zero();
-    M::Matrix P = M::Matrix::Identity() * 1e4;
+    kf.start_run({static_cast<std::uint64_t>(rep), 1, &d});
+    for (const auto& m : ms) kf.on_measurement(m, 0);
+  }
+}
+
+CvModel::State plugin_final_state(Component& kf, Consumer& c, const std::vector<Measurement>& ms) {
+  struct Last final : Component {
+    StateVec x;
+    void on_estimate(const Estimate& e, int) override { x = e.state; }
+  } last;
+  const Link links[2] = {{&c, 0, 0xFF}, {&last, 0, 0xFF}};
+  kf.out.connect(links, 2);
+  Diagnostics d;
+  kf.start_run({0, 1, &d});
+  for (const auto& m : ms) kf.on_measurement(m, 0);
+  kf.out.connect(links, 1);
+  return last.x.head<6>();
+}
+
+// The textbook step in plain fixed-size Eigen (dense F P F', Joseph update).
+CvModel::State plain_passes(const std::vector<Measurement>& ms, int reps, double& checksum) {
+  CvModel::Matrix F, Q, P0;
+  Eigen::Matrix<double, 3, 6> H;
+  CvModel::State x0;
+  model_matrices(F, Q, H, x0, P0);
+  CvModel::State x;
+  for (int rep = 0; rep < reps; ++rep) {
+    x = x0;
+    CvModel::Matrix P = P0;
+    bool first = true;
     for (const auto& m : ms) {
-      x = F * x;
-      P = F * P * F.transpose() + Q;
+      if (!first) {
+        x = F * x;
+        P = F * P * F.transpose() + Q;
+      }
+      first = false;
       const Mat3 R = m.covariance;
       const Mat3 S = H * P * H.transpose() + R;
       const Eigen::Matrix<double, 6, 3> K = P * H.transpose() * S.llt().solve(Mat3::Identity());
       x += K * (Vec3(m.value) - H * x);
-      const M::Matrix IKH = M::Matrix::Identity() - K * H;
+      const CvModel::Matrix IKH = CvModel::Matrix::Identity() - K * H;
       P = IKH * P * IKH.transpose() + K * R * K.transpose();
     }
     checksum += x(0);
   }
-  return static_cast<double>(reps) * ms.size() / seconds_since(t0);
+  return x;
+}
+
+#ifdef TRACKFLOW_BENCH_OPENCV
+// The same filter in cv::KalmanFilter (its predict() and correct(): F P F' + Q, then the
+// textbook gain and P - K H P). R is copied in at every step (it changes with full_R).
+CvModel::State opencv_passes(const std::vector<Measurement>& ms, int reps, double& checksum) {
+  CvModel::Matrix F, Q, P0;
+  Eigen::Matrix<double, 3, 6> H;
+  CvModel::State x0;
+  model_matrices(F, Q, H, x0, P0);
+  cv::KalmanFilter kf(6, 3, 0, CV_64F);
+  auto to_cv = [](const auto& A, cv::Mat& out) {
+    for (int i = 0; i < A.rows(); ++i)
+      for (int j = 0; j < A.cols(); ++j) out.at<double>(i, j) = A(i, j);
+  };
+  to_cv(F, kf.transitionMatrix);
+  to_cv(Q, kf.processNoiseCov);
+  to_cv(H, kf.measurementMatrix);
+  for (int rep = 0; rep < reps; ++rep) {
+    to_cv(x0, kf.statePre);  // correct() starts from the predicted ("pre") state
+    to_cv(P0, kf.errorCovPre);
+    bool first = true;
+    for (const auto& m : ms) {
+      if (!first) kf.predict();
+      first = false;
+      double* r = kf.measurementNoiseCov.ptr<double>();
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) r[3 * i + j] = m.covariance(i, j);
+      const cv::Mat z(3, 1, CV_64F, const_cast<double*>(m.value.data()));
+      kf.correct(z);
+    }
+    checksum += kf.statePost.at<double>(0);
+  }
+  CvModel::State x;
+  for (int i = 0; i < 6; ++i) x(i) = kf.statePost.at<double>(i);
+  return x;
+}
+#endif
+
+double relative_difference(const CvModel::State& a, const CvModel::State& b) {
+  return (a - b).norm() / std::max(a.norm(), 1e-300);
+}
+
+void row(const std::string& name, const Rate& r) {
+  std::printf("%-52s %12.0f %8.3f %12.0f %8.3f\n", name.c_str(), r.cpu, 1e6 / r.cpu, r.wall, 1e6 / r.wall);
+}
+
+void kalman_section(const host::PluginRegistry& reg, int reps, int rounds) {
+  std::printf("6-state CV Kalman step, 1000 measurements x %d passes, best of %d alternating rounds, 1 thread\n", reps,
+              rounds);
+  std::printf("%-52s %12s %8s %12s %8s\n", "", "steps/CPU-s", "us", "steps/wall-s", "us");
+  char params[400];
+  std::snprintf(params, sizeof params,
+                "{ q: %g m2/s3, init: explicit, initial_position: [%g, %g, %g], initial_velocity: [%g, %g, %g], "
+                "initial_sigma_position: %g m, initial_sigma_velocity: %g m/s }",
+                kQ, kX0[0], kX0[2], kX0[4], kX0[1], kX0[3], kX0[5], kSigmaP0, kSigmaV0);
+  for (const bool full_R : {false, true}) {
+    const auto ms = cv_measurements(1000, full_R);
+    auto kf = make(reg, "filter.kalman", params);
+    Consumer consumer;
+    const Link link{&consumer, 0, 0xFF};
+    kf->out.connect(&link, 1);
+    const double steps = static_cast<double>(reps) * ms.size();
+    Rate tf, plain, ocv;
+    double ck = 0;
+    CvModel::State x_plain, x_ocv;
+    plugin_passes(*kf, ms, reps / 10 + 1);  // warm-up
+    for (int round = 0; round < rounds; ++round) {
+      tf.add(steps, time_it([&] { plugin_passes(*kf, ms, reps); }));
+      plain.add(steps, time_it([&] { x_plain = plain_passes(ms, reps, ck); }));
+#ifdef TRACKFLOW_BENCH_OPENCV
+      ocv.add(steps, time_it([&] { x_ocv = opencv_passes(ms, reps, ck); }));
+#endif
+    }
+    const CvModel::State x_tf = plugin_final_state(*kf, consumer, ms);
+    std::printf("%s:\n", full_R ? "full R, a different one every step (converted measurements)" : "diagonal R = 25 m2 I");
+    row("  filter.kalman through the plugin", tf);
+    row("  plain fixed-size Eigen, textbook dense step", plain);
+#ifdef TRACKFLOW_BENCH_OPENCV
+    row("  OpenCV " CV_VERSION " cv::KalmanFilter (CV_64F)", ocv);
+    std::printf("  %-50s %12.2f %8s %12.2f\n", "speed ratio filter.kalman / OpenCV", tf.cpu / ocv.cpu, "",
+                tf.wall / ocv.wall);
+    std::printf("  final states: plugin vs OpenCV %.1e, plugin vs plain %.1e (relative)\n",
+                relative_difference(x_tf, x_ocv), relative_difference(x_tf, x_plain));
+#else
+    (void)ocv;
+    (void)x_ocv;
+    std::printf("  OpenCV cv::KalmanFilter: skipped (the OpenCV video module was not found when this was built: "
+                "install libopencv-video-dev and re-run cmake)\n");
+    std::printf("  final state: plugin vs plain %.1e (relative)\n", relative_difference(x_tf, x_plain));
+#endif
+    std::printf("  %-50s %12.2f %8s %12.2f\n", "speed ratio filter.kalman / plain Eigen", tf.cpu / plain.cpu, "",
+                tf.wall / plain.wall);
+  }
+}
+
+void pipeline_section(const host::PluginRegistry& reg, int runs, int rounds) {
+  auto cfg = host::parse_pipeline(host::load_yaml_file(TRACKFLOW_BENCH_PIPELINE), TRACKFLOW_BENCH_PIPELINE);
+  const host::Graph g = host::build_graph(cfg, reg);
+  host::RunOptions opt;
+  opt.runs = static_cast<std::uint64_t>(runs);
+  opt.threads = 1;
+  opt.output_dir = "/tmp/trackflow-bench-out";
+  double checksum = 0;
+  {
+    auto w = opt;
+    w.runs = 20;
+    host::run_graph(g, reg, w);
+    plain_loop(20, checksum);
+  }
+  Rate pipeline, loop;
+  for (int round = 0; round < rounds; ++round) {
+    double items = 0;
+    const Clocks c = time_it([&] { items = static_cast<double>(host::run_graph(g, reg, opt).source_items); });
+    pipeline.add(items, c);
+    double n = 0;
+    const Clocks l = time_it([&] { n = plain_loop(runs, checksum); });
+    loop.add(n, l);
+  }
+  std::printf("quickstart, %d runs x 601 steps per round, best of %d alternating rounds, 1 thread\n", runs, rounds);
+  std::printf("%-52s %12s %12s\n", "", "meas/CPU-s", "meas/wall-s");
+  std::printf("%-52s %12.0f %12.0f\n", "quickstart pipeline (engine + 5 plugins)", pipeline.cpu, pipeline.wall);
+  std::printf("%-52s %12.0f %12.0f\n", "same computation as a plain loop", loop.cpu, loop.wall);
+  std::printf("%-52s %12.2f %12.2f   (aim >= 0.9)\n", "  pipeline / plain loop", pipeline.cpu / loop.cpu,
+              pipeline.wall / loop.wall);
+  std::printf("(checksum %.6g)\n", checksum);
 }
 
 }  // namespace
 
 int main(int argc, char** argv) {
-  int runs = 2000, reps = 2000;
+  int runs = 400, reps = 400, rounds = 5;
+  std::string only;
   for (int i = 1; i + 1 < argc; i += 2) {
-    if (!std::strcmp(argv[i], "--runs")) runs = std::atoi(argv[i + 1]);
-    if (!std::strcmp(argv[i], "--reps")) reps = std::atoi(argv[i + 1]);
+    if (!std::strcmp(argv[i], "--runs")) runs = std::max(1, std::atoi(argv[i + 1]));
+    if (!std::strcmp(argv[i], "--reps")) reps = std::max(1, std::atoi(argv[i + 1]));
+    if (!std::strcmp(argv[i], "--rounds")) rounds = std::max(1, std::atoi(argv[i + 1]));
+    if (!std::strcmp(argv[i], "--only")) only = argv[i + 1];
   }
   host::PluginRegistry reg;
   reg.load_directories({TRACKFLOW_BENCH_PLUGIN_DIR});
-  auto cfg = host::parse_pipeline(host::load_yaml_file(TRACKFLOW_BENCH_PIPELINE), TRACKFLOW_BENCH_PIPELINE);
-  const host::Graph g = host::build_graph(cfg, reg);
-  host::RunOptions opt;
-  opt.runs = runs;
-  opt.threads = 1;
-  opt.output_dir = "/tmp/trackflow-bench-out";
-
-  // Warm-up of both, then measure.
-  double checksum = 0;
-  { auto w = opt; w.runs = 20; host::run_graph(g, reg, w); plain_loop(20, checksum); }
-  const host::Outcome out = host::run_graph(g, reg, opt);
-  const double pipeline_rate = out.source_items / out.seconds;
-  const double loop_rate = plain_loop(runs, checksum);
-
-  const auto ms = cv_measurements(1000);
-  const auto* kt = reg.find("filter.kalman");
-  host::Value pv = host::load_yaml_string("{ q: 1 m2/s3 }", "bench");
-  Params kp = host::validate_params(kt->decl.params, pv, "kf", {});
-  auto kf = reg.create(*kt, kp);
-  Diagnostics d;
-  double plugin_rate = 0;
-  for (int pass = 0; pass < 2; ++pass) {  // first pass warms up
-    const auto t0 = Clock::now();
-    for (int rep = 0; rep < reps; ++rep) {
-      kf->start_run({static_cast<std::uint64_t>(rep), 1, &d});
-      for (const auto& m : ms) kf->on_measurement(m, 0);
-    }
-    plugin_rate = static_cast<double>(reps) * ms.size() / seconds_since(t0);
-  }
-  double ck2 = 0;
-  plain_kalman_steps(ms, reps / 10, ck2);
-  const double plain_rate = plain_kalman_steps(ms, reps, ck2);
-
-  std::printf("quickstart pipeline (engine + 5 plugins, %d runs x 601 steps, 1 thread): %10.0f measurements/s\n", runs,
-              pipeline_rate);
-  std::printf("same computation as a plain loop                                : %10.0f measurements/s\n", loop_rate);
-  std::printf("  pipeline / plain loop                                         : %10.2f\n", pipeline_rate / loop_rate);
-  std::printf("filter.kalman CV 6-state step through the plugin (virtual call) : %10.0f steps/s (%.3f us)\n",
-              plugin_rate, 1e6 / plugin_rate);
-  std::printf("plain fixed-size Eigen CV Kalman step (textbook, Joseph)        : %10.0f steps/s (%.3f us)\n",
-              plain_rate, 1e6 / plain_rate);
-  std::printf("  plugin / plain Eigen                                          : %10.2f\n", plugin_rate / plain_rate);
-  std::printf("(checksums %.6g %.6g)\n", checksum, ck2);
+  if (only.empty() || only == "pipeline") pipeline_section(reg, runs, rounds);
+  if (only.empty()) std::printf("\n");
+  if (only.empty() || only == "kalman") kalman_section(reg, reps, rounds);
   return 0;
 }

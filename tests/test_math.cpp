@@ -84,6 +84,54 @@ TEST_CASE("Joseph update keeps P symmetric PD with textbook gain") {
   CHECK(nis == Approx(nu.dot(S.inverse() * nu)));
 }
 
+// The update from P H' and S equals the dense Joseph form (for a sparse and a dense H)
+TEST_CASE("Joseph update from P H' and S equals the dense form") {
+  auto check = [](const Eigen::Matrix<double, 4, 9>& H) {
+    Eigen::Matrix<double, 9, 9> A = Eigen::Matrix<double, 9, 9>::Random();
+    const Eigen::Matrix<double, 9, 9> P0 = A * A.transpose() + 0.1 * Eigen::Matrix<double, 9, 9>::Identity();
+    Eigen::Matrix4d B = Eigen::Matrix4d::Random();
+    const Eigen::Matrix4d R = B * B.transpose() + 0.5 * Eigen::Matrix4d::Identity();
+    const Eigen::Vector4d nu(0.3, -1.2, 0.7, 2.0);
+    Eigen::Matrix<double, 9, 1> x_dense = Eigen::Matrix<double, 9, 1>::LinSpaced(1.0, 9.0), x = x_dense;
+    Eigen::Matrix<double, 9, 9> P_dense = P0, P = P0;
+    Eigen::Matrix4d S_dense, S;
+    double nis_dense = 0, nis = 0;
+    REQUIRE(joseph_update<9, 4>(x_dense, P_dense, nu, H, R, S_dense, nis_dense));
+    const Eigen::Matrix<double, 9, 4> PHt = P0 * H.transpose();
+    S = H * PHt + R;
+    Eigen::Matrix<double, 9, 4> K;
+    REQUIRE(joseph_update_cross<9, 4>(x, P, nu, PHt, S, nis, &K));
+    CHECK((x - x_dense).norm() < 1e-12 * x_dense.norm());
+    CHECK((P - P_dense).norm() < 1e-12 * P_dense.norm());
+    CHECK((S - S_dense).norm() < 1e-12 * S_dense.norm());
+    CHECK(nis == Approx(nis_dense).epsilon(1e-12));
+    CHECK((K - PHt * S.inverse()).norm() < 1e-10 * K.norm());
+    CHECK((P - P.transpose()).norm() == 0.0);
+    CHECK(Eigen::LLT<Eigen::Matrix<double, 9, 9>>(P).info() == Eigen::Success);
+  };
+  Eigen::Matrix<double, 4, 9> sparse = Eigen::Matrix<double, 4, 9>::Zero();
+  sparse(0, 0) = 0.6, sparse(0, 3) = 0.8, sparse(1, 0) = -0.2, sparse(1, 3) = 0.3, sparse(2, 6) = 1.0;
+  sparse(3, 0) = 0.1, sparse(3, 1) = 0.6, sparse(3, 4) = 0.8;
+  check(sparse);
+  check(Eigen::Matrix<double, 4, 9>::Random());
+}
+
+// An innovation covariance that is not positive definite leaves x and P untouched
+TEST_CASE("Joseph update from P H' refuses an indefinite S") {
+  Eigen::Matrix<double, 6, 1> x = Eigen::Matrix<double, 6, 1>::Ones();
+  Eigen::Matrix<double, 6, 6> P = Eigen::Matrix<double, 6, 6>::Identity();
+  const Eigen::Matrix<double, 6, 6> P0 = P;
+  Eigen::Matrix<double, 6, 3> PHt = Eigen::Matrix<double, 6, 3>::Zero();
+  Eigen::Matrix3d S = Eigen::Matrix3d::Identity();
+  S(1, 1) = -1.0;
+  double nis = 0;
+  CHECK_FALSE(joseph_update_cross<6, 3>(x, P, Eigen::Vector3d(1, 1, 1), PHt, S, nis));
+  S(1, 1) = std::nan("");
+  CHECK_FALSE(joseph_update_cross<6, 3>(x, P, Eigen::Vector3d(1, 1, 1), PHt, S, nis));
+  CHECK(x == Eigen::Matrix<double, 6, 1>::Ones());
+  CHECK(P == P0);
+}
+
 TEST_CASE("structured covariance propagation equals F P F'") {
   auto check = [](auto model) {
     using M = decltype(model);

@@ -31,13 +31,10 @@ class KalmanFilter final : public FilterFrontEnd<KalmanFilter<Model>> {
   static constexpr int N = Model::kDim;
   using StateN = typename Model::State;
   using MatN = typename Model::Matrix;
-  using Mat3N = Eigen::Matrix<double, 3, N>;
 
  public:
   explicit KalmanFilter(KalmanSettings s)
       : FrontEnd(FrontEndSpec{"filter.kalman", s.node, Frame::Cartesian, RangeRateUse::Ignore, {}}), s_(std::move(s)) {
-    H_.setZero();
-    for (int a = 0; a < 3; ++a) H_(a, Model::position_index(a)) = 1.0;
     for (int a = 0; a < 3; ++a) {
       idx_[a] = Model::position_index(a);
       idx_[a + 3] = Model::velocity_index(a);
@@ -67,6 +64,7 @@ class KalmanFilter final : public FilterFrontEnd<KalmanFilter<Model>> {
  private:
   bool reset_track() {
     has_first_ = false;
+    independent_axes_ = true;  // explicit: P diagonal; two-point: set by initialise
     if (s_.two_point) return false;
     x_.setZero();
     P_.setZero();
@@ -97,19 +95,65 @@ class KalmanFilter final : public FilterFrontEnd<KalmanFilter<Model>> {
       P_.template block<Model::kOrder, Model::kOrder>(a * Model::kOrder, a * Model::kOrder) += scale * unit_Q_;
   }
 
+  // H selects the three positions, so P H' is three columns of P and H P H' their position rows:
+  // the Joseph-form update from them (kalman.hpp, joseph_update_cross) needs no H and no 6x6x6
+  // products. When R is diagonal and P has no cross-axis terms (independent_axes_), the three
+  // axes are three independent filters on scalar measurements: the same update, per axis.
   template <int M>
   bool update(const Measurement& m) {
-    const Vec3 nu = m.value.template head<3>() - H_ * x_;
+    const Vec3 z = m.value.template head<3>();
+    const Mat3 R = this->R_.template topLeftCorner<3, 3>();
+    Vec3 nu;
+    for (int a = 0; a < 3; ++a) nu(a) = z(a) - x_(Model::position_index(a));
     Mat3 S;
     double nis = 0.0;
-    const Mat3 R = this->R_.topLeftCorner(3, 3);
-    if (joseph_update<N, 3>(x_, P_, nu, H_, R, S, nis)) {
+    bool ok;
+    if (independent_axes_ && diagonal(R)) {
+      ok = update_per_axis(nu, R, S, nis);
+    } else {
+      independent_axes_ = false;  // cross-axis terms from here on
+      Eigen::Matrix<double, N, 3> PHt;
+      for (int a = 0; a < 3; ++a) PHt.col(a) = P_.col(Model::position_index(a));
+      for (int a = 0; a < 3; ++a)
+        for (int b = 0; b < 3; ++b) S(a, b) = PHt(Model::position_index(a), b) + R(a, b);
+      ok = joseph_update_cross<N, 3>(x_, P_, nu, PHt, S, nis);
+    }
+    if (ok) {
       this->template accept_update<3>(nu, S, nis);
       return true;
     }
     this->warn("innovation covariance not positive definite at t=" + std::to_string(m.time) +
                " s; measurement not used");
     return false;
+  }
+
+  static bool diagonal(const Mat3& A) {
+    return A(0, 1) == 0.0 && A(0, 2) == 0.0 && A(1, 2) == 0.0 && A(1, 0) == 0.0 && A(2, 0) == 0.0 && A(2, 1) == 0.0;
+  }
+
+  // P block-diagonal per axis and R diagonal: each axis block is updated with its own position,
+  // exactly the update above with the zero cross terms left out.
+  bool update_per_axis(const Vec3& nu, const Mat3& R, Mat3& S, double& nis) {
+    constexpr int O = Model::kOrder;
+    for (int a = 0; a < 3; ++a)
+      if (!(P_(a * O, a * O) + R(a, a) > 0.0)) return false;  // x, P untouched, as the full update
+    S.setZero();
+    nis = 0.0;
+    for (int a = 0; a < 3; ++a) {
+      Eigen::Matrix<double, O, 1> xa = x_.template segment<O>(a * O);
+      typename Model::AxisMatrix Pa = P_.template block<O, O>(a * O, a * O);
+      const Eigen::Matrix<double, O, 1> PHt = Pa.col(0);
+      Eigen::Matrix<double, 1, 1> s, nu_a;
+      s(0, 0) = Pa(0, 0) + R(a, a);
+      nu_a(0) = nu(a);
+      double nis_a = 0.0;
+      joseph_update_cross<O, 1>(xa, Pa, nu_a, PHt, s, nis_a);
+      x_.template segment<O>(a * O) = xa;
+      P_.template block<O, O>(a * O, a * O) = Pa;
+      S(a, a) = s(0, 0);
+      nis += nis_a;
+    }
+    return true;
   }
 
   void scale_state_covariance(double k) { P_ *= k; }
@@ -143,6 +187,8 @@ class KalmanFilter final : public FilterFrontEnd<KalmanFilter<Model>> {
       if constexpr (Model::kOrder == 3) P_(a * 3 + 2, a * 3 + 2) = s_.sa0 * s_.sa0;
     }
     P_ = 0.5 * (P_ + P_.transpose()).eval();
+    // Diagonal R at both points: no cross-axis terms in P (exactly zero, not merely small).
+    independent_axes_ = diagonal(R) && diagonal(R1_);
     return true;
   }
 
@@ -159,9 +205,10 @@ class KalmanFilter final : public FilterFrontEnd<KalmanFilter<Model>> {
   StateN x_ = StateN::Zero();
   MatN P_ = MatN::Identity();
   typename Model::AxisMatrix unit_Q_ = Model::AxisMatrix::Zero();
-  Mat3N H_;
   double last_T_ = -1.0;
   bool has_first_ = false;
+  // P has no cross-axis terms (R diagonal so far): F, Q and a diagonal-R update keep it so.
+  bool independent_axes_ = true;
   Vec3 z1_ = Vec3::Zero();
   Mat3 R1_ = Mat3::Zero();
   double t1_ = 0.0;
@@ -205,7 +252,7 @@ void register_components(Registrar& r) {
   d.doc =
       "State [x vx (ax) y vy (ay) z vz (az)] in ENU. Process noise: continuous white noise on the highest "
       "derivative (CV: q [[T^3/3, T^2/2], [T^2/2, T]], CA: Wiener-process acceleration, paper 000 eq 3.19) or, "
-      "with sigma_accel, the discrete white-noise model (sigma^2 G G'). Joseph-form update. Invalid measurements: "
+      "with sigma_accel, the discrete white-noise model (sigma^2 G G'). Joseph-form update (per axis while R is diagonal). Invalid measurements: "
       "predict only (coast). Measurement noise R from each measurement's covariance; adapters may replace it.";
   d.accepts = mask(ItemKind::Measurement);
   d.accepts_frames = mask(Frame::Cartesian);

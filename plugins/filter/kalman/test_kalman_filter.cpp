@@ -93,6 +93,56 @@ TEST_CASE("CV filter agrees with a textbook Kalman filter") {
   CHECK(last.enu(3) == last.state(1));  // vx sits at index 1 of the interleaved state
 }
 
+// A diagonal R keeps the axes independent (the per-axis update); the first correlated R switches
+// to the full update for good. Both must agree with the textbook filter at every step.
+TEST_CASE("diagonal then correlated R agrees with a textbook filter") {
+  auto kf = test::make("filter.kalman", "{ motion: constant_velocity, q: 3 m2/s3 }");
+  test::Collector out;
+  out.attach_to(*kf);
+  Diagnostics d;
+  kf->start_run({0, 1, &d});
+  Rng rng(11);
+  const double T = 0.1;
+  std::vector<Measurement> ms;
+  for (int k = 0; k < 80; ++k) {
+    const double t = k * T;
+    Measurement m = cartesian(t, Vec3(500 + 40 * t, 700 - 20 * t, 100 + 5 * t), 1.0);
+    Mat3 R = Vec3(4.0, 9.0 + k, 16.0).asDiagonal();
+    if (k >= 40) {  // correlated from here on
+      R(0, 1) = R(1, 0) = 2.0;
+      R(1, 2) = R(2, 1) = -3.0;
+    }
+    const Eigen::LLT<Mat3> llt(R);
+    m.value = Vec3(m.value.head<3>() + llt.matrixL() * Vec3(rng.normal(), rng.normal(), rng.normal()));
+    m.covariance = R;
+    ms.push_back(m);
+    kf->on_measurement(m, 0);
+  }
+  ReferenceKf ref;
+  ref.q = 3.0;
+  ref.x = Eigen::VectorXd::Zero(6);
+  ref.P = Eigen::MatrixXd::Zero(6, 6);
+  const Mat3 R0 = ms[0].covariance, R1 = ms[1].covariance;
+  for (int a = 0; a < 3; ++a) {
+    ref.x(2 * a) = ms[1].value(a);
+    ref.x(2 * a + 1) = (ms[1].value(a) - ms[0].value(a)) / T;
+    ref.P(2 * a, 2 * a) = R1(a, a);
+    ref.P(2 * a, 2 * a + 1) = ref.P(2 * a + 1, 2 * a) = R1(a, a) / T;
+    ref.P(2 * a + 1, 2 * a + 1) = (R0(a, a) + R1(a, a)) / (T * T);
+  }
+  for (size_t k = 2; k < ms.size(); ++k) {
+    ref.predict(T);
+    ref.update(ms[k].value.head<3>(), ms[k].covariance.topLeftCorner(3, 3));
+    const auto& e = out.estimates[k];
+    INFO("step " << k);
+    CHECK((e.state - ref.x).norm() < 1e-9 * ref.x.norm());
+    CHECK((e.covariance - ref.P).norm() < 1e-9 * ref.P.norm());
+    CHECK((e.covariance - e.covariance.transpose()).norm() == 0.0);
+    if (k < 40) CHECK(e.covariance(0, 2) == 0.0);  // no cross-axis term while R is diagonal
+  }
+  CHECK(out.estimates.back().covariance(0, 2) != 0.0);
+}
+
 // NEES of the CV filter on a CV target is consistent over 300 runs
 TEST_CASE("CV filter NEES is consistent over 300 runs") {
   const int runs = 300, steps = 40;
