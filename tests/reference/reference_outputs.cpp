@@ -7,13 +7,18 @@
 //
 // Tolerance. Two values a (reference) and b (now) agree when
 //   |a - b| <= 1e-9 max(|a|, |b|)            (relative), or
-//   |a - b| <= 1e-9 scale                    (absolute floor for values near 0),
+//   |a - b| <= 1e-8 scale                    (absolute floor for values near 0),
 // where scale is the value's own uncertainty: sqrt(P_ii) for state element i, sqrt(P_ii P_jj) for
 // covariance entry (i, j), the RMS of the state's standard deviations for an innovation (its units
 // are the measurement's, so no state variance is its scale; the floor only matters for innovations
 // near 0), 1 for NIS and annotations. An off-diagonal covariance near 0 thus has a tolerance of
-// 1e-9 in correlation, and a state near 0 of 1e-9 of its standard deviation. Row structure
-// (run, step, flags, sizes) must match exactly.
+// 1e-8 in correlation, and a state near 0 (within its sigma) of 1e-8 of its standard deviation.
+// Why 1e-8 for the floor: the reference's own rounding noise reaches ~1e-9 of sigma on the long
+// runs (16 000 steps at 40 Hz of a CA filter whose acceleration is barely observable): changing
+// only how the original code symmetrises P (mirroring the upper triangle instead of averaging it
+// with its transpose, a one-ulp change per step) moved its estimates by up to 7e-10 sigma
+// (shot_noise, worst_noise); the floor sits a decade above that noise. Row structure (run, step,
+// flags, sizes) must match exactly.
 #include <trackflow/host/config.hpp>
 #include <trackflow/host/engine.hpp>
 #include <trackflow/host/graph.hpp>
@@ -34,7 +39,7 @@ namespace fs = std::filesystem;
 
 namespace {
 
-constexpr double kRelative = 1e-9;
+constexpr double kRelative = 1e-9, kFloor = 1e-8;
 
 struct Case {
   const char* name;      // ctest name and file prefix
@@ -182,7 +187,7 @@ int compare(const fs::path& ref_file, const fs::path& now_file, int& values) {
       } else if (c == 2) {
         scale = 0.0;  // time: relative only
       }
-      const double diff = std::fabs(a - b), tol = kRelative * std::max({std::fabs(a), std::fabs(b), scale});
+      const double diff = std::fabs(a - b), tol = std::max(kRelative * std::max(std::fabs(a), std::fabs(b)), kFloor * scale);
       const double rel = diff / std::max({std::fabs(a), std::fabs(b), scale, 1e-300});
       if (rel > worst) {
         worst = rel;
@@ -263,7 +268,7 @@ int main(int argc, char** argv) {
       }
       bad += compare(ref, fs::path(opt.output_dir) / (id + ".csv"), values);
     }
-    std::printf("%s: %d values compared, %d disagree (tolerance 1e-9 relative, floor 1e-9 of the value's own "
+    std::printf("%s: %d values compared, %d disagree (tolerance 1e-9 relative, floor 1e-8 of the value's own "
                 "standard deviation)\n",
                 c->name, values, bad);
     return bad ? 1 : 0;

@@ -81,6 +81,43 @@ SphericalSingularity spherical_measurement_jacobian(const Vec3& d, const Vec3& v
   return zenith ? SphericalSingularity::Zenith : SphericalSingularity::None;
 }
 
+// spherical_measurement and spherical_measurement_jacobian in one: the same values bit for bit
+// (the same expressions), with the horizontal range and the range computed once for both.
+template <int M>
+SphericalSingularity spherical_measurement_with_jacobian(const Vec3& d, const Vec3& v, AzimuthConvention c,
+                                                         SphericalVec<M>& h, SphericalJacobian<M>& H) {
+  static_assert(M == 3 || M == 4);
+  H.setZero();
+  const double rho_true = std::hypot(d.x(), d.y());
+  const double r = std::hypot(rho_true, d.z());
+  h(0) = r;
+  h(1) = c == AzimuthConvention::NorthClockwise ? std::atan2(d.x(), d.y()) : std::atan2(d.y(), d.x());
+  h(2) = std::atan2(d.z(), rho_true);
+  if constexpr (M == 4) h(3) = range_rate(d, v);
+  if (!(r >= kMinRange)) return SphericalSingularity::AtSensor;
+  const bool zenith = rho_true < kZenithFraction * r;
+  const double ux = rho_true > 0.0 ? d.x() / rho_true : 1.0, uy = rho_true > 0.0 ? d.y() / rho_true : 0.0;
+  const double inv_rho = 1.0 / std::max(rho_true, kZenithFraction * r);
+  const double r2 = r * r;
+  H.template block<1, 3>(0, 0) = d.transpose() / r;
+  if (c == AzimuthConvention::NorthClockwise) {
+    H(1, 0) = uy * inv_rho;
+    H(1, 1) = -ux * inv_rho;
+  } else {
+    H(1, 0) = -uy * inv_rho;
+    H(1, 1) = ux * inv_rho;
+  }
+  H(2, 0) = -ux * d.z() / r2;
+  H(2, 1) = -uy * d.z() / r2;
+  H(2, 2) = rho_true / r2;
+  if constexpr (M == 4) {
+    const double dv = d.dot(v);
+    H.template block<1, 3>(3, 0) = (v * r2 - dv * d).transpose() / (r2 * r);
+    H.template block<1, 3>(3, 3) = d.transpose() / r;
+  }
+  return zenith ? SphericalSingularity::Zenith : SphericalSingularity::None;
+}
+
 // z - h with the azimuth difference wrapped to (-pi, pi]. Elevation lies in [-pi/2, pi/2] and
 // is not wrapped.
 template <int M>

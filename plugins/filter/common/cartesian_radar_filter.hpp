@@ -123,14 +123,51 @@ class CartesianRadarFilter : public FilterFrontEnd<CartesianRadarFilter<Order, D
       const Eigen::Matrix<double, Order, 1> xa = axisF_ * x_.template segment<Order>(a * Order);
       x_.template segment<Order>(a * Order) = xa;
     }
-    // F is block-diagonal: (F P F')_ab = A P_ab A'.
-    for (int a = 0; a < 3; ++a)
-      for (int b = 0; b < 3; ++b) {
-        const AxisMatrix Pab = axisF_ * P_.template block<Order, Order>(a * Order, b * Order) * axisF_.transpose();
-        P_.template block<Order, Order>(a * Order, b * Order) = Pab;
+    propagate_covariance();
+    for (int a = 0; a < 3; ++a) {
+      const double s = noise_scale(a);
+      for (int j = 0; j < Order; ++j)
+        for (int i = 0; i <= j; ++i) P_(a * Order + i, a * Order + j) += s * axisQ_(i, j);
+    }
+    for (int j = 0; j < N; ++j)
+      for (int i = 0; i < j; ++i) P_(j, i) = P_(i, j);
+  }
+
+  // P <- F P F' (upper triangle) with F block-diagonal and each axis block upper triangular with
+  // a unit diagonal except the last element: CV [[1, T], [0, 1]], CA and Singer
+  // [[1, f01, f02], [0, 1, f12], [0, 0, f22]]. Row operations give F P, the same on the columns
+  // of its upper triangle give F P F': 108 + 57 multiplications for CA instead of 9 dense 3x3x3
+  // block products (486) (and no symmetrisation: the lower triangle is mirrored by the caller).
+  void propagate_covariance() {
+    const double f01 = axisF_(0, 1);
+    double f02 = 0.0, f12 = 0.0, f22 = 1.0;
+    if constexpr (Order == 3) {
+      f02 = axisF_(0, 2);
+      f12 = axisF_(1, 2);
+      f22 = axisF_(2, 2);
+    }
+    for (int a = 0; a < 3; ++a) {
+      const int i = a * Order;
+      for (int c = 0; c < N; ++c) {
+        if constexpr (Order == 3) {
+          P_(i, c) += f01 * P_(i + 1, c) + f02 * P_(i + 2, c);
+          P_(i + 1, c) += f12 * P_(i + 2, c);
+          P_(i + 2, c) *= f22;
+        } else {
+          P_(i, c) += f01 * P_(i + 1, c);
+        }
       }
-    for (int a = 0; a < 3; ++a) P_.template block<Order, Order>(a * Order, a * Order) += noise_scale(a) * axisQ_;
-    P_ = 0.5 * (P_ + P_.transpose()).eval();
+    }
+    for (int b = 0; b < 3; ++b) {
+      const int j = b * Order;
+      if constexpr (Order == 3) {
+        for (int r = 0; r <= j; ++r) P_(r, j) += f01 * P_(r, j + 1) + f02 * P_(r, j + 2);
+        for (int r = 0; r <= j + 1; ++r) P_(r, j + 1) += f12 * P_(r, j + 2);
+        for (int r = 0; r <= j + 2; ++r) P_(r, j + 2) *= f22;
+      } else {
+        for (int r = 0; r <= j; ++r) P_(r, j) += f01 * P_(r, j + 1);
+      }
+    }
   }
 
   void compute_axis_model(double T) {

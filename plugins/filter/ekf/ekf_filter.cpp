@@ -37,27 +37,44 @@ class ExtendedKalmanFilter final
   void on_start_run() { zenith_reported_ = false; }
   void on_end_run_report() {}
 
+  // H = dh/dx is non-zero only in the position columns (and, for the range rate, the velocity
+  // columns): P H' and H P H' are formed from those (kalman.hpp, joseph_update_cross), never the
+  // M x N H or an N x N x N product.
   template <int M>
   bool correct(const Measurement& m) {
     using MatM = Eigen::Matrix<double, M, M>;
     const Vec3 d = Layout::position(x_) - m.sensor_position;
     const Vec3 v = Layout::velocity(x_);
-    SphericalJacobian<M> J;
-    const SphericalSingularity sing = spherical_measurement_jacobian<M>(d, v, m.azimuth, J);
+    SphericalJacobian<M> J;  // columns [x y z vx vy vz]
+    SphericalVec<M> h;
+    const SphericalSingularity sing = spherical_measurement_with_jacobian<M>(d, v, m.azimuth, h, J);
     if (sing == SphericalSingularity::AtSensor) {
       this->warn("predicted position at the sensor at t=" + std::to_string(m.time) +
                  " s: no direction to linearise about; measurement not used");
       return false;
     }
     const SphericalVec<M> z = m.value.template head<M>();
-    SphericalVec<M> nu = spherical_residual<M>(z, spherical_measurement<M>(d, v, m.azimuth));
-    MatM R = R_.topLeftCorner(M, M);
-    Eigen::Matrix<double, M, N> H = Eigen::Matrix<double, M, N>::Zero();
-    for (int k = 0; k < 6; ++k) H.col(idx_[k]) = J.col(k);
-    if (this->settings().zenith == cartesian_filter::Settings::Zenith::Curvature) condition_near_zenith<M>(m, d, sing, H, nu, R);
+    SphericalVec<M> nu = spherical_residual<M>(z, h);
+    MatM R = R_.template topLeftCorner<M, M>();
+    if (this->settings().zenith == cartesian_filter::Settings::Zenith::Curvature) condition_near_zenith<M>(m, d, sing, J, nu, R);
+    // Rows r, az, el depend on the position only; the range rate's also on the velocity.
+    Eigen::Matrix<double, N, M> PHt;
+    for (int k = 0; k < M; ++k)
+      for (int r = 0; r < N; ++r) {
+        double s = P_(r, idx_[0]) * J(k, 0) + P_(r, idx_[1]) * J(k, 1) + P_(r, idx_[2]) * J(k, 2);
+        if (k == 3) s += P_(r, idx_[3]) * J(k, 3) + P_(r, idx_[4]) * J(k, 4) + P_(r, idx_[5]) * J(k, 5);
+        PHt(r, k) = s;
+      }
     MatM S;
+    for (int k = 0; k < M; ++k)
+      for (int l = k; l < M; ++l) {
+        const int c = l == 3 ? 6 : 3;  // H P H' = H (P H'): row l of H against column k of P H'
+        double s = R(l, k);
+        for (int j = 0; j < c; ++j) s += J(l, j) * PHt(idx_[j], k);
+        S(l, k) = s;
+      }
     double nis = 0.0;
-    if (joseph_update<N, M>(x_, P_, nu, H, R, S, nis)) {
+    if (joseph_update_cross<N, M>(x_, P_, nu, PHt, S, nis)) {
       this->template accept_update<M>(nu, S, nis);
       return true;
     }
@@ -72,8 +89,8 @@ class ExtendedKalmanFilter final
   // azimuth may flip by pi and is dropped: zero row, zero innovation, R decorrelated (an
   // infinitely uncertain azimuth; range, elevation and range rate still update).
   template <int M>
-  void condition_near_zenith(const Measurement& m, const Vec3& d, SphericalSingularity sing,
-                             Eigen::Matrix<double, M, N>& H, SphericalVec<M>& nu, Eigen::Matrix<double, M, M>& R) {
+  void condition_near_zenith(const Measurement& m, const Vec3& d, SphericalSingularity sing, SphericalJacobian<M>& J,
+                             SphericalVec<M>& nu, Eigen::Matrix<double, M, M>& R) {
     Eigen::Matrix2d Ph;
     Ph << P_(idx_[0], idx_[0]), P_(idx_[0], idx_[1]), P_(idx_[1], idx_[0]), P_(idx_[1], idx_[1]);
     const ekf::AngleCurvature curvature = ekf::angle_curvature_variance(d, Ph, kZenithFraction * d.norm());
@@ -81,7 +98,7 @@ class ExtendedKalmanFilter final
     R(2, 2) += curvature.elevation;
     const bool drop_azimuth = sing == SphericalSingularity::Zenith || curvature.azimuth_unusable;
     if (drop_azimuth) {
-      H.row(1).setZero();
+      J.row(1).setZero();
       nu(1) = 0.0;
       R.row(1).setZero();
       R.col(1).setZero();

@@ -238,9 +238,11 @@ TEST_CASE("guarded Cholesky: PD singular and indefinite P") {
   Rng rng(12);
   Mat6d P = random_covariance(rng, (Vec6d() << 10, 1, 10, 1, 10, 1).finished());
   const Mat6d P0 = P;
-  Eigen::LLT<Mat6d> llt;
-  CHECK(ukf::guarded_cholesky<6>(P, llt) == 0.0);
+  Mat6d L;
+  CHECK(ukf::guarded_cholesky<6>(P, L) == 0.0);
   CHECK(P == P0);
+  CHECK((L * L.transpose() - P).norm() < 1e-12 * P.norm());
+  CHECK((L - Mat6d(P.llt().matrixL())).norm() < 1e-12 * L.norm());
 
   // Indefinite at the rounding level (smallest eigenvalue -1e-9 of the largest variance), as
   // P - K S K' can become, and slightly asymmetric.
@@ -250,21 +252,20 @@ TEST_CASE("guarded Cholesky: PD singular and indefinite P") {
   S(0, 1) += 1e-14 * scale;
   const Mat6d S0 = S;
   REQUIRE(S.llt().info() != Eigen::Success);
-  const double jitter = ukf::guarded_cholesky<6>(S, llt);
+  const double jitter = ukf::guarded_cholesky<6>(S, L);
   CHECK(jitter > 1e-9 * scale);
   CHECK(jitter <= 1e-7 * scale);
   CHECK(S.isApprox(S.transpose(), 0.0));
-  const Mat6d L = llt.matrixL();
   CHECK(L.allFinite());
   CHECK((L * L.transpose() - S).norm() < 1e-12 * S.norm());
   CHECK((S - S0).norm() < 1e-3 * S0.norm());
 
   Mat6d I = Mat6d::Identity();
   I(3, 3) = -0.5;
-  CHECK(ukf::guarded_cholesky<6>(I, llt) < 0.0);
+  CHECK(ukf::guarded_cholesky<6>(I, L) < 0.0);
   Mat6d nan = Mat6d::Identity();
   nan(2, 2) = std::numeric_limits<double>::quiet_NaN();
-  CHECK(ukf::guarded_cholesky<6>(nan, llt) < 0.0);
+  CHECK(ukf::guarded_cholesky<6>(nan, L) < 0.0);
   Mat6d zero = Mat6d::Zero();
-  CHECK(ukf::guarded_cholesky<6>(zero, llt) < 0.0);
+  CHECK(ukf::guarded_cholesky<6>(zero, L) < 0.0);
 }

@@ -1,5 +1,6 @@
 // Purpose: filter.ukf — scaled unscented Kalman filter with a Cartesian ENU state (CV, CA or Singer motion) on spherical [r, az, el(, rdot)] measurements.
 #include "cartesian_radar_filter.hpp"
+#include "sigma_spherical.hpp"
 #include "unscented_transform.hpp"
 
 #include <trackflow/kalman.hpp>
@@ -70,7 +71,8 @@ class UnscentedKalmanFilter final
   bool correct(const Measurement& m) {
     using MatM = Eigen::Matrix<double, M, M>;
     ++updates_;
-    const double jitter = ukf::guarded_cholesky<N>(P_, llt_);
+    MatN L;
+    const double jitter = ukf::guarded_cholesky<N>(P_, L);
     if (jitter < 0.0) {
       this->warn("state covariance at t=" + std::to_string(m.time) +
                  " s cannot be factored for sigma points; measurement not used");
@@ -80,35 +82,69 @@ class UnscentedKalmanFilter final
       ++jitter_count_;
       max_jitter_ = std::max(max_jitter_, jitter);
     }
-    const MatN L = llt_.matrixL();
-    const Vec3 sensor = m.sensor_position;
-    const AzimuthConvention convention = m.azimuth;
-    const int* idx = idx_;
-    auto h = [sensor, convention, idx](const StateN& s) {
-      const Vec3 d = Vec3(s(idx[0]), s(idx[1]), s(idx[2])) - sensor;
-      const Vec3 v(s(idx[3]), s(idx[4]), s(idx[5]));
-      return spherical_measurement<M>(d, v, convention);
-    };
+    // The sigma points x ± c L_j measured as offsets from the centre (sigma_spherical.hpp). h
+    // reads the position (and, with the range rate, the velocity): a column of L that moves
+    // neither gives h(x) itself (the last one, which moves only the last acceleration).
+    const ukf::SphericalNearCentre<M> near(Layout::position(x_) - m.sensor_position, Layout::velocity(x_), m.azimuth);
+    constexpr int kRead = M == 4 ? 6 : 3;
+    const double c = weights_.spread;
+    typename ukf::SphericalNearCentre<M>::template Batch<2 * N> points;
+    int slot[N];  // points.z[slot[j]] = h(x + c L_j), points.z[slot[j] + 1] = h(x - c L_j); -1: h(x)
+    for (int j = 0; j < N; ++j) {
+      bool moves = false;
+      for (int k = 0; k < kRead; ++k) moves |= L(idx_[k], j) != 0.0;
+      slot[j] = moves ? points.count : -1;
+      if (!moves) continue;
+      for (const double sign : {c, -c}) {
+        const int k = points.count++;
+        points.ex[k] = sign * L(idx_[0], j);
+        points.ey[k] = sign * L(idx_[1], j);
+        points.ez[k] = sign * L(idx_[2], j);
+        points.fx[k] = sign * L(idx_[3], j);
+        points.fy[k] = sign * L(idx_[4], j);
+        points.fz[k] = sign * L(idx_[5], j);
+      }
+    }
+    near.evaluate(points);
+    SphericalVec<M> zp[N], zm[N];
+    for (int j = 0; j < N; ++j) {
+      zp[j] = slot[j] < 0 ? near.centre() : points.z[slot[j]];
+      zm[j] = slot[j] < 0 ? near.centre() : points.z[slot[j] + 1];
+    }
     ukf::MeasurementMoments<N, M> ut;
-    ukf::unscented_measurement<N, M>(x_, L, weights_, h, ut);
+    ukf::moments_from_points<N, M>(near.centre(), zp, zm, L, weights_, ut, false);
     const SphericalVec<M> z = m.value.template head<M>();
     const SphericalVec<M> nu = spherical_residual<M>(z, ut.mean);
     // The Joseph form with the statistically linearised H and R + extra gives the textbook
     // UKF's gain P_xz S^-1 and its P - K S K', but as a sum of two positive semi-definite
     // terms (unscented_transform.hpp; docs/filters.md).
-    MatM R = R_.topLeftCorner(M, M);
+    MatM R = R_.template topLeftCorner<M, M>();
     R += ut.extra;
     // A negative W0c can make R + extra indefinite, and with it P - K S K'. Then the negative
     // part of `extra` is removed (eigenvalues clamped at 0), so R + extra >= R.
     if (weights_.cov0 < 0.0 && Eigen::LLT<MatM>(R).info() != Eigen::Success) {
       const Eigen::SelfAdjointEigenSolver<MatM> eig(ut.extra);
-      R = R_.topLeftCorner(M, M);
+      R = R_.template topLeftCorner<M, M>();
       R += eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() * eig.eigenvectors().transpose();
       ++spread_clamped_count_;
     }
+    // H = G' L^-1 is never formed: P H' = L L' H' = L G (L lower triangular), H P H' = G' G.
+    Eigen::Matrix<double, N, M> PHt;
+    for (int k = 0; k < M; ++k)
+      for (int r = 0; r < N; ++r) {
+        double s = 0.0;
+        for (int j = 0; j <= r; ++j) s += L(r, j) * ut.G(j, k);
+        PHt(r, k) = s;
+      }
     MatM S;
+    for (int k = 0; k < M; ++k)
+      for (int l = k; l < M; ++l) {
+        double s = R(l, k);
+        for (int j = 0; j < N; ++j) s += ut.G(j, l) * ut.G(j, k);
+        S(l, k) = s;
+      }
     double nis = 0.0;
-    if (joseph_update<N, M>(x_, P_, nu, ut.H, R, S, nis)) {
+    if (joseph_update_cross<N, M>(x_, P_, nu, PHt, S, nis)) {
       this->template accept_update<M>(nu, S, nis);
       return true;
     }
@@ -118,7 +154,6 @@ class UnscentedKalmanFilter final
   }
 
   ukf::ScaledWeights weights_;
-  Eigen::LLT<MatN> llt_;
   int jitter_count_ = 0, spread_clamped_count_ = 0, updates_ = 0;
   double max_jitter_ = 0.0;
 };

@@ -6,6 +6,7 @@
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
 
+#include <array>
 #include <cmath>
 
 namespace trackflow::ukf {
@@ -31,24 +32,43 @@ struct ScaledWeights {
   }
 };
 
-// Cholesky factor of P for the sigma points. If P is not numerically positive definite it is
+// Lower Cholesky factor L L' = A from A's lower triangle (as Eigen::LLT reads it); the upper
+// triangle of L is zero. False when a pivot is not positive (or NaN). Plain loops over fixed
+// sizes: for a 9 x 9 P this takes about half the time of Eigen::LLT's blocked code.
+template <int N>
+bool cholesky_lower(const Eigen::Matrix<double, N, N>& A, Eigen::Matrix<double, N, N>& L) {
+  L.setZero();
+  for (int j = 0; j < N; ++j) {
+    double d = A(j, j);
+    for (int k = 0; k < j; ++k) d -= L(j, k) * L(j, k);
+    if (!(d > 0.0)) return false;
+    const double ljj = std::sqrt(d), inv = 1.0 / ljj;
+    L(j, j) = ljj;
+    for (int i = j + 1; i < N; ++i) {
+      double s = A(i, j);
+      for (int k = 0; k < j; ++k) s -= L(i, k) * L(j, k);
+      L(i, j) = s * inv;
+    }
+  }
+  return true;
+}
+
+// Cholesky factor L of P for the sigma points. If P is not numerically positive definite it is
 // symmetrised and a growing multiple of its largest variance (1e-12 ... 1e-4) is added to the
 // diagonal; P itself is replaced by the matrix that was factored, so the sigma points and the
 // update describe the same covariance. Returns the jitter added (0: none) or -1 if P could not
 // be factored (non-finite, or indefinite beyond 1e-4 of its scale).
 template <int N>
-double guarded_cholesky(Eigen::Matrix<double, N, N>& P, Eigen::LLT<Eigen::Matrix<double, N, N>>& llt) {
-  if (!P.allFinite()) return -1.0;  // LLT would "succeed" on a NaN diagonal (NaN <= 0 is false)
-  llt.compute(P);
-  if (llt.info() == Eigen::Success) return 0.0;
+double guarded_cholesky(Eigen::Matrix<double, N, N>& P, Eigen::Matrix<double, N, N>& L) {
+  if (!P.allFinite()) return -1.0;
+  if (cholesky_lower<N>(P, L)) return 0.0;
   P = (0.5 * (P + P.transpose())).eval();
   const double scale = P.diagonal().cwiseAbs().maxCoeff();
   if (!(scale > 0.0)) return -1.0;
   for (double rel = 1e-12; rel <= 1.001e-4; rel *= 100.0) {
     Eigen::Matrix<double, N, N> Pj = P;
     Pj.diagonal().array() += rel * scale;
-    llt.compute(Pj);
-    if (llt.info() == Eigen::Success) {
+    if (cholesky_lower<N>(Pj, L)) {
       P = Pj;
       return rel * scale;
     }
@@ -65,24 +85,31 @@ double guarded_cholesky(Eigen::Matrix<double, N, N>& P, Eigen::LLT<Eigen::Matrix
 //   H L = G',  G_j = (dZ_{+j} - dZ_{-j})' / (2c)     (central differences along the sigma directions)
 //   extra = W0c dZ_0 dZ_0' + 2 Wi sum_j s_j s_j',  s_j = (dZ_{+j} + dZ_{-j}) / 2
 // "extra" is a sum of outer products: positive semi-definite whenever W0c >= 0, with no
-// cancellation (unlike P_zz - H P H').
+// cancellation (unlike P_zz - H P H'). A filter need not form H: P H' = L L' H' = L G and
+// H P H' = G' G.
 template <int N, int M>
 struct MeasurementMoments {
   Eigen::Matrix<double, M, 1> mean;
-  Eigen::Matrix<double, M, N> H;
+  Eigen::Matrix<double, M, N> H;  // formed only when asked (with_H)
+  Eigen::Matrix<double, N, M> G;
   Eigen::Matrix<double, M, M> extra;
 };
 
-// h(const Eigen::Matrix<double, N, 1>&) -> Eigen::Matrix<double, M, 1> with the azimuth in
-// element 1 (the SDK's spherical layout [r, az, el(, rdot)]).
-template <int N, int M, class MeasurementFn>
-void unscented_measurement(const Eigen::Matrix<double, N, 1>& x, const Eigen::Matrix<double, N, N>& L,
-                           const ScaledWeights& w, MeasurementFn&& h, MeasurementMoments<N, M>& out) {
+// The state components h reads. A sigma direction L_j that moves none of them gives h(x ± c L_j)
+// = h(x) bit for bit (the same arguments), so it is not evaluated: with the Cholesky factor of a
+// [p v a] per-axis state, the last column moves only the last acceleration.
+template <int N>
+using StateMask = std::array<bool, N>;
+
+// The moments above from the measured sigma points: z0 = h(x), zp[j] = h(x + c L_j),
+// zm[j] = h(x - c L_j), their azimuths (element 1) already within pi of z0's (z0(1) + the wrapped
+// difference).
+template <int N, int M>
+void moments_from_points(const Eigen::Matrix<double, M, 1>& z0, const Eigen::Matrix<double, M, 1> (&zp)[N],
+                         const Eigen::Matrix<double, M, 1> (&zm)[N], const Eigen::Matrix<double, N, N>& L,
+                         const ScaledWeights& w, MeasurementMoments<N, M>& out, bool with_H) {
   using VecM = Eigen::Matrix<double, M, 1>;
-  using VecN = Eigen::Matrix<double, N, 1>;
   const double c = w.spread;
-  const VecM z0 = h(x);
-  VecM zp[N], zm[N];
   // Azimuths are taken relative to the centre point's and wrapped: every sigma point lies
   // within pi of it, so the weighted average is an ordinary one in a chart where the ±pi cut
   // does not occur (the plain weighted mean wherever the points spread over less than pi). The
@@ -90,14 +117,7 @@ void unscented_measurement(const Eigen::Matrix<double, N, 1>& x, const Eigen::Ma
   // it differs from the mean once the points lie unevenly, and with a negative W0 it is not an
   // average at all.
   VecM sum = VecM::Zero();
-  for (int j = 0; j < N; ++j) {
-    const VecN step = c * L.col(j);
-    zp[j] = h(VecN(x + step));
-    zm[j] = h(VecN(x - step));
-    zp[j](1) = z0(1) + wrap_angle(zp[j](1) - z0(1));
-    zm[j](1) = z0(1) + wrap_angle(zm[j](1) - z0(1));
-    sum += zp[j] + zm[j];
-  }
+  for (int j = 0; j < N; ++j) sum += zp[j] + zm[j];
   VecM mean = w.mean0 * z0 + w.other * sum;
   // Residuals of each point from the mean, azimuth wrapped to (-pi, pi].
   auto residual = [&mean](const VecM& z) {
@@ -106,7 +126,7 @@ void unscented_measurement(const Eigen::Matrix<double, N, 1>& x, const Eigen::Ma
     return d;
   };
   const VecM d0 = residual(z0);
-  Eigen::Matrix<double, N, M> G;
+  Eigen::Matrix<double, N, M>& G = out.G;
   out.extra.setZero();
   for (int j = 0; j < N; ++j) {
     const VecM dp = residual(zp[j]), dm = residual(zm[j]);
@@ -116,9 +136,36 @@ void unscented_measurement(const Eigen::Matrix<double, N, 1>& x, const Eigen::Ma
   }
   out.extra.noalias() += w.cov0 * d0 * d0.transpose();
   // H = G' L^-1, i.e. L' H' = G.
-  out.H.transpose() = L.transpose().template triangularView<Eigen::Upper>().solve(G);
+  if (with_H) out.H.transpose() = L.transpose().template triangularView<Eigen::Upper>().solve(G);
   mean(1) = wrap_angle(mean(1));
   out.mean = mean;
+}
+
+// h(const Eigen::Matrix<double, N, 1>&) -> Eigen::Matrix<double, M, 1> with the azimuth in
+// element 1 (the SDK's spherical layout [r, az, el(, rdot)]).
+template <int N, int M, class MeasurementFn>
+void unscented_measurement(const Eigen::Matrix<double, N, 1>& x, const Eigen::Matrix<double, N, N>& L,
+                           const ScaledWeights& w, MeasurementFn&& h, MeasurementMoments<N, M>& out,
+                           const StateMask<N>* reads = nullptr, bool with_H = true) {
+  using VecM = Eigen::Matrix<double, M, 1>;
+  using VecN = Eigen::Matrix<double, N, 1>;
+  const double c = w.spread;
+  const VecM z0 = h(x);
+  VecM zp[N], zm[N];
+  for (int j = 0; j < N; ++j) {
+    bool moves = !reads;
+    for (int i = 0; i < N && !moves; ++i) moves = (*reads)[i] && L(i, j) != 0.0;
+    if (!moves) {
+      zp[j] = zm[j] = z0;  // h(x ± c L_j) = h(x): z0(1) + wrap(0) = z0(1)
+    } else {
+      const VecN step = c * L.col(j);
+      zp[j] = h(VecN(x + step));
+      zm[j] = h(VecN(x - step));
+      zp[j](1) = z0(1) + wrap_angle(zp[j](1) - z0(1));
+      zm[j](1) = z0(1) + wrap_angle(zm[j](1) - z0(1));
+    }
+  }
+  moments_from_points<N, M>(z0, zp, zm, L, w, out, with_H);
 }
 
 }  // namespace trackflow::ukf
