@@ -15,6 +15,8 @@
 //     states are compared as a check that the three compute the same filter. OpenCV is optional:
 //     without it (Debian libopencv-video-dev) its rows are skipped with a message.
 #include "bench_common.hpp"
+#include "chi_square_band.hpp"
+#include "nees.hpp"
 
 #include <trackflow/geometry.hpp>
 #include <trackflow/host/engine.hpp>
@@ -41,19 +43,26 @@ using namespace trackflow::bench;
 
 namespace {
 
-// The quickstart computation without the framework. Same parameters as pipelines/quickstart.yaml.
-// Returns the number of measurements processed.
+// The quickstart computation without the framework. Same parameters as pipelines/quickstart.yaml
+// and the same outputs as its summary: per time step the sums sink.metrics keeps (squared error
+// and error per ENU component, NEES and position NEES, NIS, the measurement's squared error),
+// reduced at the end to position/velocity RMSE (total and per axis), mean error per axis, the
+// largest per-step position RMS, ANEES (and the fraction of steps in the chi-square band),
+// ANEES of the position, ANIS, measurement RMSE and the RMSE ratio. The filter is filter.kalman's
+// step written with the same SDK math (structured F P F', Joseph update from P H'). Returns the
+// number of measurements processed; adds a checksum of the outputs.
 double plain_loop(int runs, double& checksum) {
   using M = ConstantVelocity;
-  const double T = 0.1, q = 0.001, sr = 10.0, sa = 1e-3, se = 1e-3;
+  const double T = 0.1, q = 0.0, sr = 10.0, sa = 1e-3, se = 1e-3;
   const int steps = 601;
   const Vec3 p0(6000, 8000, 1000), v0(-150, 50, 0);
-  M::Matrix F, Q;
-  M::transition(T, F);
+  M::Matrix Q;
   M::block_diagonal(M::axis_noise_continuous(T, q), Q);
-  Eigen::Matrix<double, 3, 6> H = Eigen::Matrix<double, 3, 6>::Zero();
-  for (int a = 0; a < 3; ++a) H(a, M::position_index(a)) = 1;
-  std::vector<double> sq_err(steps), nees(steps), meas_sq(steps);
+  struct Step {
+    double sq[6] = {}, sum[6] = {}, nees = 0, nees_position = 0, nis = 0, meas_sq = 0;
+    int estimates = 0, nis_count = 0;
+  };
+  std::vector<Step> step(steps);
   for (int run = 0; run < runs; ++run) {
     Rng rng(derive_seed(1, run, "radar"));
     M::State x;
@@ -61,6 +70,7 @@ double plain_loop(int runs, double& checksum) {
     Vec3 z1;
     Mat3 R1;
     for (int k = 0; k < steps; ++k) {
+      Step& st = step[k];
       const double t = k * T;
       const Vec3 p = p0 + v0 * t;
       const Vec3 s = enu_to_spherical(p, AzimuthConvention::NorthClockwise);
@@ -69,7 +79,7 @@ double plain_loop(int runs, double& checksum) {
       const Mat3 J = spherical_to_enu_jacobian(r, az, el, AzimuthConvention::NorthClockwise);
       Mat3 R = J * Vec3(sr * sr, sa * sa, se * se).asDiagonal() * J.transpose();
       R = 0.5 * (R + R.transpose()).eval();
-      meas_sq[k] += (z - p).squaredNorm();
+      st.meas_sq += (z - p).squaredNorm();
       if (k == 0) {
         z1 = z;
         R1 = R;
@@ -90,32 +100,77 @@ double plain_loop(int runs, double& checksum) {
         }
       } else {
         M::propagate(T, x);
-        const M::Matrix FP = F * P;
-        P.noalias() = FP * F.transpose();
+        M::propagate_covariance(T, P);
         P += Q;
-        const Vec3 nu = z - H * x;
+        Vec3 nu;
+        Eigen::Matrix<double, 6, 3> PHt;
         Mat3 S;
-        double nis;
-        joseph_update<6, 3>(x, P, nu, H, R, S, nis);
+        for (int a = 0; a < 3; ++a) {
+          nu(a) = z(a) - x(M::position_index(a));
+          PHt.col(a) = P.col(M::position_index(a));
+        }
+        for (int a = 0; a < 3; ++a)
+          for (int b = 0; b < 3; ++b) S(a, b) = PHt(M::position_index(a), b) + R(a, b);
+        double nis = 0;
+        if (joseph_update_cross<6, 3>(x, P, nu, PHt, S, nis)) {
+          st.nis += nis;
+          ++st.nis_count;
+        }
       }
-      Vec6 e, enu;
-      Mat6 C;
+      // Error against the truth; NEES and position NEES as sink.metrics computes them (nees.hpp).
       const int idx[6] = {0, 2, 4, 1, 3, 5};
+      Vec6 e;
+      Mat6 C;
       for (int i = 0; i < 6; ++i) {
-        enu(i) = x(idx[i]);
+        e(i) = x(idx[i]) - (i < 3 ? p(i) : v0(i - 3));
         for (int j = 0; j < 6; ++j) C(i, j) = P(idx[i], idx[j]);
       }
-      e << enu.head<3>() - p, enu.tail<3>() - v0;
-      sq_err[k] += e.head<3>().squaredNorm();
-      nees[k] += e.dot(C.ldlt().solve(e));
+      ++st.estimates;
+      for (int i = 0; i < 6; ++i) {
+        st.sq[i] += e(i) * e(i);
+        st.sum[i] += e(i);
+      }
+      double terms[6];
+      if (metrics::nees_terms(C, e, terms)) {
+        st.nees_position += terms[0] + terms[1] + terms[2];
+        st.nees += terms[0] + terms[1] + terms[2] + terms[3] + terms[4] + terms[5];
+      }
     }
   }
-  double sum = 0, ne = 0;
-  for (int k = 1; k < steps; ++k) {
-    sum += sq_err[k];
-    ne += nees[k];
+  // The summary's reductions.
+  double sq[6] = {}, sum[6] = {}, n = 0, max_rms = 0, anees = 0, anees_position = 0, anis = 0, meas_sq = 0;
+  int nees_steps = 0, in_band = 0, nis_steps = 0;
+  const metrics::Band band = metrics::chi_square_band(6.0 * runs, 0.95);
+  for (const Step& st : step) {
+    meas_sq += st.meas_sq;
+    if (st.estimates == 0) continue;
+    for (int i = 0; i < 6; ++i) {
+      sq[i] += st.sq[i];
+      sum[i] += st.sum[i];
+    }
+    n += st.estimates;
+    max_rms = std::max(max_rms, std::sqrt((st.sq[0] + st.sq[1] + st.sq[2]) / st.estimates));
+    const double a = st.nees / (6.0 * st.estimates);
+    anees += a;
+    anees_position += st.nees_position / (3.0 * st.estimates);
+    in_band += a >= band.lo && a <= band.hi;
+    ++nees_steps;
+    if (st.nis_count) {
+      anis += st.nis / (3.0 * st.nis_count);
+      ++nis_steps;
+    }
   }
-  checksum += std::sqrt(sum / ((steps - 1.0) * runs)) + ne / ((steps - 1.0) * runs * 6);
+  const double position_rmse = std::sqrt((sq[0] + sq[1] + sq[2]) / n);
+  const double measurement_rmse = std::sqrt(meas_sq / (static_cast<double>(runs) * steps));
+  const double outputs[] = {position_rmse,
+                            std::sqrt((sq[3] + sq[4] + sq[5]) / n),
+                            std::sqrt(sq[0] / n), std::sqrt(sq[1] / n), std::sqrt(sq[2] / n),
+                            std::sqrt(sq[3] / n), std::sqrt(sq[4] / n), std::sqrt(sq[5] / n),
+                            sum[0] / n, sum[1] / n, sum[2] / n, max_rms,
+                            anees / nees_steps, anees_position / nees_steps,
+                            static_cast<double>(in_band) / nees_steps, anis / nis_steps,
+                            measurement_rmse, position_rmse / measurement_rmse};
+  for (double v : outputs) checksum += v;
   return static_cast<double>(runs) * steps;
 }
 

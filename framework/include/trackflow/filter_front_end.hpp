@@ -7,6 +7,7 @@
 
 #include <Eigen/Core>
 
+#include <cmath>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -176,6 +177,14 @@ class FilterFrontEnd : public Filter {
   Diagnostics* diagnostics() const { return diag_; }
   // Time of the measurement being processed (predict() runs to it).
   double time() const { return time_; }
+  // Whether the interval T to this measurement equals `last_T` to the precision of the time
+  // stamps (4 ulps of the current time), so that a motion model computed for last_T may be used
+  // again. Fixed-rate data are stamped t0 + k / rate, rounded: their intervals differ in the last
+  // bits (by up to ~5e-12 of a 25 ms interval after 540 s), which no model can resolve, and
+  // comparing them exactly would recompute F and Q at nearly every step.
+  bool same_interval(double T, double last_T) const {
+    return std::fabs(T - last_T) <= 4.0 * std::numeric_limits<double>::epsilon() * std::fabs(time_);
+  }
   void count(int counter) { ++run_.counters[counter]; }
 
   template <int M>

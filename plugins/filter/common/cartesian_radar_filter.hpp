@@ -115,7 +115,7 @@ class CartesianRadarFilter : public FilterFrontEnd<CartesianRadarFilter<Order, D
   void on_end_run() { derived().on_end_run_report(); }
 
   void predict(double T) {
-    if (T != last_T_) {  // fixed-rate data: F and the unit-intensity Q are computed once
+    if (!this->same_interval(T, last_T_)) {  // fixed-rate data: F and the unit-intensity Q are computed once
       compute_axis_model(T);
       last_T_ = T;
     }

@@ -66,7 +66,7 @@ class DecoupledFilter final : public FilterFrontEnd<DecoupledFilter> {
 
   void predict(double T) {
     const double q = s_.q;
-    if (T != last_T_ || q != last_q_) {  // an adapter may retune q between steps
+    if (!same_interval(T, last_T_) || q != last_q_) {  // an adapter may retune q between steps
       Q_axis_ = s_.noise == DecoupledSettings::Noise::Continuous ? ConstantVelocity::axis_noise_continuous(T, q)
                                                                  : ConstantVelocity::axis_noise_discrete(T, q);
       last_T_ = T;

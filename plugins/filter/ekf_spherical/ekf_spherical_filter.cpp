@@ -110,7 +110,7 @@ class SphericalEkf final : public FilterFrontEnd<SphericalEkf> {
   }
 
   void predict(double T) {
-    if (T != last_T_) {  // fixed-rate data: the unit-intensity Q1 is computed once
+    if (!same_interval(T, last_T_)) {  // fixed-rate data: the unit-intensity Q1 is computed once
       unit_Q1_ = ConstantAcceleration::axis_noise_continuous(T, 1.0);
       last_T_ = T;
     }

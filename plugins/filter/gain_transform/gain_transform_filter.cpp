@@ -63,7 +63,7 @@ class GainTransformFilter final : public FilterFrontEnd<GainTransformFilter> {
   }
 
   void predict(double T) {
-    if (T != last_T_) {  // fixed-rate data: F and the unit-sigma Q are computed once
+    if (!same_interval(T, last_T_)) {  // fixed-rate data: F and the unit-sigma Q are computed once
       const Eigen::Matrix3d F = SingerModel::axis_transition(s_.alpha, T);
       const Eigen::Matrix3d Q = (2.0 * s_.alpha) * SingerModel::noise_per_psd(s_.alpha, T);
       model_ = {F(0, 1), F(0, 2), F(1, 2), F(2, 2), {Q(0, 0), Q(0, 1), Q(0, 2), Q(1, 1), Q(1, 2), Q(2, 2)}};
@@ -191,14 +191,17 @@ class GainTransformFilter final : public FilterFrontEnd<GainTransformFilter> {
 
   // The published covariance is blkdiag(D) P̄ blkdiag(D)' (enu_covariance()): the ENU covariance
   // the decoupled blocks stand for, in motion.hpp's layout like filter.ekf's Singer state.
+  // Formed in a fixed-size matrix and copied once (the Estimate's is sized at run time).
   void fill_estimate(Estimate& e) const {
     for (int i = 0; i < 9; ++i) e.state(i) = x_[i];
-    enu_covariance(B_, frame_.u, e.covariance);
+    Eigen::Matrix<double, 9, 9> P;
+    enu_covariance(B_, frame_.u, P);
+    e.covariance = P;
     constexpr int kIndex[6] = {state_index(0, 0), state_index(1, 0), state_index(2, 0),
                                state_index(0, 1), state_index(1, 1), state_index(2, 1)};
-    for (int i = 0; i < 6; ++i) {
-      e.enu(i) = x_[kIndex[i]];
-      for (int j = 0; j < 6; ++j) e.enu_covariance(i, j) = e.covariance(kIndex[i], kIndex[j]);
+    for (int j = 0; j < 6; ++j) {
+      e.enu(j) = x_[kIndex[j]];
+      for (int i = 0; i < 6; ++i) e.enu_covariance(i, j) = P(kIndex[i], kIndex[j]);
     }
   }
 

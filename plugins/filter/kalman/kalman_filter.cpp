@@ -82,7 +82,7 @@ class KalmanFilter final : public FilterFrontEnd<KalmanFilter<Model>> {
   }
 
   void predict(double T) {
-    if (T != last_T_) {  // fixed-rate data: the unit-intensity Q is computed once per T
+    if (!this->same_interval(T, last_T_)) {  // fixed-rate data: the unit-intensity Q is computed once per T
       unit_Q_ = s_.noise == KalmanSettings::Noise::Continuous ? Model::axis_noise_continuous(T, 1.0)
                                                                : Model::axis_noise_discrete(T, 1.0);
       last_T_ = T;
@@ -101,6 +101,10 @@ class KalmanFilter final : public FilterFrontEnd<KalmanFilter<Model>> {
   // axes are three independent filters on scalar measurements: the same update, per axis.
   template <int M>
   bool update(const Measurement& m) {
+    return update_position(m);  // the front end's range_rate: ignore makes M = 3; one body
+  }
+
+  bool update_position(const Measurement& m) {
     const Vec3 z = m.value.template head<3>();
     const Mat3 R = this->R_.template topLeftCorner<3, 3>();
     Vec3 nu;

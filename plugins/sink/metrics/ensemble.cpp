@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <iterator>
 #include <string>
 
 namespace trackflow::metrics {
@@ -20,8 +21,13 @@ void Ensemble::add(const MetricsRunResult& run) {
   measurement_sq_error += run.measurement_sq_error;
   measurements_matched += run.measurements_matched;
   measurements_unmatched += run.measurements_unmatched;
+  // Records come in time order and every run has (nearly) the same steps: the step after the
+  // previous record's is the hint, which makes each lookup or insertion O(1) instead of O(log n).
+  auto hint = steps.begin();
   for (const EstimateRecord& r : run.records) {
-    StepSums& s = steps[r.key];
+    const auto it = steps.try_emplace(hint, r.key);
+    hint = std::next(it);
+    StepSums& s = it->second;
     if (!s.has_time) {
       s.time = r.time;
       s.has_time = true;
@@ -57,8 +63,11 @@ void Ensemble::add(const MetricsRunResult& run) {
       }
     }
   }
+  hint = steps.begin();
   for (const MeasurementRecord& m : run.measurement_records) {
-    StepSums& s = steps[m.key];
+    const auto it = steps.try_emplace(hint, m.key);
+    hint = std::next(it);
+    StepSums& s = it->second;
     if (!s.has_time) {
       s.time = m.time;
       s.has_time = true;

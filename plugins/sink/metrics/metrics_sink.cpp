@@ -1,11 +1,11 @@
 // Purpose: sink.metrics — ensemble RMSE, bias, ANEES and ANIS (with chi-square bands) of one filter against truth.
 #include "ensemble.hpp"
+#include "nees.hpp"
 #include "truth_match.hpp"
 
 #include <trackflow/geometry.hpp>
 #include <trackflow/plugin.hpp>
 
-#include <Eigen/Cholesky>
 
 #include <algorithm>
 #include <cmath>
@@ -168,12 +168,11 @@ class MetricsSink final : public Component {
     }
     rec.matched = true;
     rec.error = e.enu - truth;
-    // LLT rejects non-positive pivots but lets NaN through, hence the finiteness checks.
-    const Eigen::LLT<Mat6> full(e.covariance);
-    const Eigen::LLT<Mat3> position(e.covariance.topLeftCorner<3, 3>());
-    if (e.covariance.allFinite() && full.info() == Eigen::Success && position.info() == Eigen::Success) {
-      rec.nees = full.matrixL().solve(rec.error).squaredNorm();
-      rec.nees_position = position.matrixL().solve(rec.error.head<3>()).squaredNorm();
+    // NEES and position NEES from one factorisation of the covariance (nees.hpp).
+    double terms[6];
+    if (e.covariance.allFinite() && metrics::nees_terms(e.covariance, rec.error, terms)) {
+      rec.nees_position = terms[0] + terms[1] + terms[2];
+      rec.nees = rec.nees_position + terms[3] + terms[4] + terms[5];
       rec.has_nees = std::isfinite(rec.nees) && std::isfinite(rec.nees_position);
     }
     if (!rec.has_nees) ++r.not_positive_definite;
