@@ -27,7 +27,24 @@ host::PluginRegistry load_plugins(const Common& c, const std::vector<std::string
 }
 
 void warn_problems(const host::PluginRegistry& reg) {
+  if (!is_root()) return;  // the same warning from every process of an MPI job would be noise
   for (const auto& p : reg.problems()) std::cerr << "trackflow: warning: plugin not loaded: " << p.str() << "\n";
+}
+
+namespace {
+host::MpiSession* g_mpi = nullptr;
+}
+host::MpiSession* mpi_session() { return g_mpi; }
+void set_mpi_session(host::MpiSession* s) { g_mpi = s; }
+
+std::string error_text(const std::exception& e) {
+  if (const auto* c = dynamic_cast<const ConfigError*>(&e)) return c->message();
+  return e.what();
+}
+
+host::Outcome run_ensemble(const host::Graph& g, const host::PluginRegistry& reg, const host::RunOptions& ro) {
+  if (host::MpiSession* mpi = mpi_session()) return host::run_graph_distributed(g, reg, ro, *mpi);
+  return host::run_graph(g, reg, ro);
 }
 
 bool parse(int argc, char** argv, po::options_description& opts, po::positional_options_description& pos,

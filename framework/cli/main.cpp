@@ -112,7 +112,8 @@ int cmd_run(int argc, char** argv, bool report_mode = false) {
   if (file.empty()) throw po::error(std::string(report_mode ? "report" : "run") + " needs a pipeline FILE");
   const bool want_report = report_mode || !report_html.empty();
   std::string track_node;
-  Loaded l = load_pipeline(file, sets, c, want_report ? static_cast<long long>(track_run) : -1, &track_node);
+  Loaded l;
+  agreed_setup([&] { l = load_pipeline(file, sets, c, want_report ? static_cast<long long>(track_run) : -1, &track_node); });
   RunOptions ro;
   ro.runs = vm.count("runs") ? runs : l.graph.config.runs;
   if (ro.runs == 0) throw ConfigError("--runs must be at least 1");
@@ -121,7 +122,7 @@ int cmd_run(int argc, char** argv, bool report_mode = false) {
   ro.seed = vm.count("seed") ? seed : l.graph.config.seed;
   l.graph.config.seed = ro.seed;
   ro.output_dir = out_dir.empty() ? (std::filesystem::path("out") / l.graph.config.name).string() : out_dir;
-  if (!no_progress && !quiet && ::isatty(STDERR_FILENO) && ro.runs > 1) {
+  if (!no_progress && !quiet && is_root() && ::isatty(STDERR_FILENO) && ro.runs > 1) {
     ro.progress = [](std::uint64_t done, std::uint64_t total) {
       const int width = 40;
       const int filled = static_cast<int>(width * done / std::max<std::uint64_t>(total, 1));
@@ -132,7 +133,8 @@ int cmd_run(int argc, char** argv, bool report_mode = false) {
   if (want_report && track_run >= ro.runs)
     throw ConfigError("--track-run " + std::to_string(track_run) + ": there are only " + std::to_string(ro.runs) +
                       " runs (0 to " + std::to_string(ro.runs - 1) + ")");
-  Outcome out = run_graph(l.graph, l.reg, ro);
+  Outcome out = run_ensemble(l.graph, l.reg, ro);
+  if (!is_root()) return kOk;  // rank 0 of the MPI job reports, checks and writes
   auto results = check_expects(l.graph, out);
   if (!metrics_json.empty()) write_metrics_json(metrics_json, out);
   ReportRequest req;
@@ -146,6 +148,9 @@ int cmd_run(int argc, char** argv, bool report_mode = false) {
   const bool all_pass = std::all_of(results.begin(), results.end(), [](const ExpectResult& r) { return r.passed; });
   if (!quiet) {
     print_summary(std::cout, l.graph, out, std::min<std::uint64_t>(ro.threads, ro.runs), results);
+    if (const host::MpiSession* mpi = mpi_session())
+      std::cout << "(runs shared by " << mpi->size() << " MPI processes, " << ro.threads << " thread"
+                << (ro.threads == 1 ? "" : "s") << " each)\n";
     for (const auto& f : written) std::cout << "wrote " << f << "\n";
   } else {
     for (const auto& r : results)
@@ -313,6 +318,28 @@ int cmd_describe(int argc, char** argv) {
   return kOk;
 }
 
+std::string rank_prefix(const host::MpiSession* mpi) {
+  return mpi && mpi->rank() != 0 ? "rank " + std::to_string(mpi->rank()) + ": " : std::string();
+}
+
+int run_command(const std::string& cmd, int argc, char** argv) {
+  {
+    // Commands that only inspect: one process of an MPI job answers.
+    if (!is_root() && (cmd == "validate" || cmd == "plugins" || cmd == "describe")) return kOk;
+    if (cmd == "run") return cmd_run(argc - 1, argv + 1);
+    if (cmd == "report") return cmd_run(argc - 1, argv + 1, true);
+    if (cmd == "validate") return cmd_validate(argc - 1, argv + 1);
+    if (cmd == "plugins") return cmd_plugins(argc - 1, argv + 1);
+    if (cmd == "describe") return cmd_describe(argc - 1, argv + 1);
+    if (cmd == "sweep") return cmd_sweep(argc - 1, argv + 1);
+    if (is_root())
+      std::cerr << "trackflow: unknown command '" << cmd << "'"
+                << did_you_mean(cmd, {"run", "report", "validate", "plugins", "describe", "sweep"}) << "\n\n"
+                << kTopHelp;
+    return kBadInput;
+  }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -322,30 +349,38 @@ int main(int argc, char** argv) {
   }
   const std::string cmd = argv[1];
   if (cmd == "--version") {
-    std::cout << "trackflow " << kSdkVersion << " (plugin ABI " << kAbiVersion << ")\n";
+    std::cout << "trackflow " << kSdkVersion << " (plugin ABI " << kAbiVersion << (host::mpi_built() ? ", MPI" : "")
+              << ")\n";
     return kOk;
   }
+  std::unique_ptr<host::MpiSession> mpi;
+  int code = kOk;
+  // In an MPI job only rank 0 prints errors: the others fail the same way (the same command
+  // line), or report to rank 0 (agreed_setup, the distributed engine). Internal errors are
+  // printed by whichever process has them.
+  auto quiet = [&mpi] { return mpi && mpi->rank() != 0; };
   try {
-    if (cmd == "run") return cmd_run(argc - 1, argv + 1);
-    if (cmd == "report") return cmd_run(argc - 1, argv + 1, true);
-    if (cmd == "validate") return cmd_validate(argc - 1, argv + 1);
-    if (cmd == "plugins") return cmd_plugins(argc - 1, argv + 1);
-    if (cmd == "describe") return cmd_describe(argc - 1, argv + 1);
-    if (cmd == "sweep") return cmd_sweep(argc - 1, argv + 1);
-    std::cerr << "trackflow: unknown command '" << cmd << "'"
-              << did_you_mean(cmd, {"run", "report", "validate", "plugins", "describe", "sweep"}) << "\n\n" << kTopHelp;
-    return kBadInput;
+    mpi = host::start_mpi_if_launched(argc, argv);
+    set_mpi_session(mpi.get());
+    code = run_command(cmd, argc, argv);
+  } catch (const host::ReportedElsewhere&) {
+    code = kBadInput;  // rank 0 prints it
   } catch (const ConfigError& e) {
-    std::cerr << "trackflow: error: " << e.message() << "\n";
-    return kBadInput;
+    if (!quiet()) std::cerr << "trackflow: error: " << e.message() << "\n";
+    code = kBadInput;
   } catch (const DataError& e) {
-    std::cerr << "trackflow: data error: " << e.what() << "\n";
-    return kBadInput;
+    if (!quiet()) std::cerr << "trackflow: data error: " << e.what() << "\n";
+    code = kBadInput;
   } catch (const po::error& e) {
-    std::cerr << "trackflow " << cmd << ": " << e.what() << " (see trackflow " << cmd << " --help)\n";
-    return kBadInput;
+    if (!quiet()) std::cerr << "trackflow " << cmd << ": " << e.what() << " (see trackflow " << cmd << " --help)\n";
+    code = kBadInput;
   } catch (const std::exception& e) {
-    std::cerr << "trackflow: internal error: " << e.what() << "\n";
-    return kInternal;
+    std::cerr << "trackflow: internal error: " << rank_prefix(mpi.get()) << e.what() << "\n";
+    code = kInternal;
   }
+  // Every process of an MPI job exits with the job's code (the largest).
+  if (mpi) code = mpi->agree_exit_code(code);
+  set_mpi_session(nullptr);
+  return code;
 }
+

@@ -97,7 +97,8 @@ int cmd_sweep(int argc, char** argv) {
       "metric,m", po::value(&metric_names)->composing(),
       "node.metric to tabulate (repeatable; default: position_rmse, velocity_rmse and anees of every "
       "node that reports them)")("runs,n", po::value(&runs), "Monte Carlo runs per grid point (default: the pipeline's)")(
-      "threads,j", po::value(&threads)->default_value(1), "grid points run in parallel")(
+      "threads,j", po::value(&threads)->default_value(1),
+      "grid points run in parallel (in an MPI job: threads per process for each point's runs)")(
       "seed", po::value(&seed), "base seed (default: the pipeline's)")(
       "set", po::value(&sets)->composing(), "fixed override for every point, as for run")(
       "csv", po::value(&csv_path), "also write the table to this CSV file (SI numbers, units in the header)")(
@@ -118,22 +119,26 @@ int cmd_sweep(int argc, char** argv) {
   const auto grid = host::sweep_grid(axes);
 
   // Build (and so validate) every point's graph before running any: a bad value fails fast.
-  const host::Value root = host::load_yaml_file(file);
-  const host::PipelineConfig base = host::parse_pipeline(root, file, fixed);
-  host::PluginRegistry reg = load_plugins(c, base.plugin_paths);
-  warn_problems(reg);
+  host::PipelineConfig base;
+  host::PluginRegistry reg;
   std::vector<host::Graph> graphs;
-  for (size_t i = 0; i < grid.size(); ++i) {
-    auto overrides = fixed;
-    overrides.insert(overrides.end(), grid[i].begin(), grid[i].end());
-    try {
-      graphs.push_back(host::build_graph(host::parse_pipeline(root, file, overrides), reg));
-    } catch (const ConfigError& e) {
-      std::string point;
-      for (const auto& ov : grid[i]) point += " " + ov.node + "." + ov.param + "=" + ov.value;
-      throw ConfigError(std::string(e.what()) + " (grid point" + point + ")", e.where(), e.node());
+  agreed_setup([&] {
+    const host::Value root = host::load_yaml_file(file);
+    base = host::parse_pipeline(root, file, fixed);
+    reg = load_plugins(c, base.plugin_paths);
+    warn_problems(reg);
+    for (size_t i = 0; i < grid.size(); ++i) {
+      auto overrides = fixed;
+      overrides.insert(overrides.end(), grid[i].begin(), grid[i].end());
+      try {
+        graphs.push_back(host::build_graph(host::parse_pipeline(root, file, overrides), reg));
+      } catch (const ConfigError& e) {
+        std::string point;
+        for (const auto& ov : grid[i]) point += " " + ov.node + "." + ov.param + "=" + ov.value;
+        throw ConfigError(std::string(e.what()) + " (grid point" + point + ")", e.where(), e.node());
+      }
     }
-  }
+  });
 
   std::vector<host::Outcome> outcomes(grid.size());
   std::atomic<size_t> next{0}, done{0};
@@ -161,10 +166,25 @@ int cmd_sweep(int argc, char** argv) {
       if (::isatty(STDERR_FILENO)) std::cerr << "\rgrid point " << d << "/" << grid.size() << std::flush;
     }
   };
-  std::vector<std::thread> pool;
-  const unsigned nthreads = std::max(1u, std::min<unsigned>(threads, static_cast<unsigned>(grid.size())));
-  for (unsigned t = 0; t < nthreads; ++t) pool.emplace_back(worker);
-  for (auto& t : pool) t.join();
+  if (host::MpiSession* mpi = mpi_session()) {
+    // An MPI job runs the points one after another, each point's runs shared by all processes
+    // (--threads per process); rank 0 merges, writes the sinks' files and prints the table.
+    for (size_t i = 0; i < grid.size(); ++i) {
+      host::RunOptions ro;
+      ro.runs = vm.count("runs") ? runs : graphs[i].config.runs;
+      ro.seed = vm.count("seed") ? seed : graphs[i].config.seed;
+      ro.threads = std::max(1u, threads);
+      ro.output_dir = (std::filesystem::path(out_root) / ("sweep-" + std::to_string(i))).string();
+      outcomes[i] = run_ensemble(graphs[i], reg, ro);
+      if (is_root() && ::isatty(STDERR_FILENO)) std::cerr << "\rgrid point " << i + 1 << "/" << grid.size() << std::flush;
+    }
+    if (!is_root()) return kOk;
+  } else {
+    std::vector<std::thread> pool;
+    const unsigned nthreads = std::max(1u, std::min<unsigned>(threads, static_cast<unsigned>(grid.size())));
+    for (unsigned t = 0; t < nthreads; ++t) pool.emplace_back(worker);
+    for (auto& t : pool) t.join();
+  }
   if (::isatty(STDERR_FILENO)) std::cerr << "\n";
   if (error) std::rethrow_exception(error);
 

@@ -4,6 +4,7 @@
 #include <trackflow/component.hpp>
 #include <trackflow/error.hpp>
 #include <trackflow/common_params.hpp>
+#include <trackflow/run_result_codec.hpp>
 
 #include <Eigen/Core>
 
@@ -51,7 +52,7 @@ struct FrontEndRunResult final : RunResult {
 // and may hide (defaults below): check_measurement(m) for further checks on valid measurements,
 // on_end_run() for per-run reports.
 template <class Derived>
-class FilterFrontEnd : public Filter {
+class FilterFrontEnd : public Filter, public RunResultCodec {
  public:
   void start_run(const RunContext& ctx) final {
     diag_ = ctx.diagnostics;
@@ -118,6 +119,25 @@ class FilterFrontEnd : public Filter {
   std::unique_ptr<RunResult> end_run() final {
     derived().on_end_run();
     return std::make_unique<FrontEndRunResult>(run_);
+  }
+
+  // Per-run counts cross processes as bytes (mpirun; run_result_codec.hpp).
+  void save_run_result(const RunResult& result, ByteWriter& out) const final {
+    const auto& r = static_cast<const FrontEndRunResult&>(result);
+    out.put(r.updates);
+    out.put(r.coasted);
+    out.put(r.non_finite);
+    out.put(r.rejected);
+    out.put(r.counters);
+  }
+  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const final {
+    auto r = std::make_unique<FrontEndRunResult>();
+    in.get(r->updates);
+    in.get(r->coasted);
+    in.get(r->non_finite);
+    in.get(r->rejected);
+    in.get(r->counters);
+    return r;
   }
 
   void merge(RunResult& result) final {

@@ -4,6 +4,7 @@
 #include <trackflow/geometry.hpp>
 #include <trackflow/noise.hpp>
 #include <trackflow/plugin.hpp>
+#include <trackflow/run_result_codec.hpp>
 
 #include <array>
 #include <cmath>
@@ -50,7 +51,7 @@ struct QualityRunResult final : RunResult {
   std::uint64_t rms_count[kChannels] = {};
 };
 
-class QualitySwitchAdapter final : public Adapter {
+class QualitySwitchAdapter final : public Adapter, public RunResultCodec {
  public:
   explicit QualitySwitchAdapter(const Settings& s)
       : s_(s),
@@ -129,6 +130,33 @@ class QualitySwitchAdapter final : public Adapter {
   }
 
   std::unique_ptr<RunResult> end_run() override { return std::make_unique<QualityRunResult>(run_); }
+
+  // Per-run counts cross processes under mpirun (run_result_codec.hpp).
+  void save_run_result(const RunResult& result, ByteWriter& out) const override {
+    const auto& r = static_cast<const QualityRunResult&>(result);
+    out.put(r.steps);
+    out.put(r.invalid);
+    out.put(r.resets);
+    out.put(r.switches);
+    out.put(r.ungraded);
+    out.put(r.table_steps);
+    out.put(r.graded);
+    out.put(r.rms_sum);
+    out.put(r.rms_count);
+  }
+  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override {
+    auto r = std::make_unique<QualityRunResult>();
+    in.get(r->steps);
+    in.get(r->invalid);
+    in.get(r->resets);
+    in.get(r->switches);
+    in.get(r->ungraded);
+    in.get(r->table_steps);
+    in.get(r->graded);
+    in.get(r->rms_sum);
+    in.get(r->rms_count);
+    return r;
+  }
 
   void merge(RunResult& result) override {
     const auto& r = static_cast<QualityRunResult&>(result);

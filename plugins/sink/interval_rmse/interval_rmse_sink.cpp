@@ -3,6 +3,7 @@
 
 #include <trackflow/geometry.hpp>
 #include <trackflow/plugin.hpp>
+#include <trackflow/run_result_codec.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -25,7 +26,7 @@ struct IntervalRunResult final : RunResult {
 };
 
 // Items are stored during the run and scored in end_run(), when all truth has arrived.
-class IntervalRmseSink final : public Component {
+class IntervalRmseSink final : public Component, public RunResultCodec {
  public:
   IntervalRmseSink(double start, double interval, double skip_initial, double tolerance)
       : start_(start), interval_(interval), skip_initial_(skip_initial), tolerance_(tolerance) {
@@ -84,6 +85,21 @@ class IntervalRmseSink final : public Component {
     if (single)  // measurements carry no target id: only a single truth target can score them
       for (const auto& m : measurements_)
         if (m.time >= from) score(m, metrics::truth_for(truth_, 0), *r, false);
+    return r;
+  }
+
+  // Per-run bins cross processes under mpirun (run_result_codec.hpp).
+  void save_run_result(const RunResult& result, ByteWriter& out) const override {
+    const auto& r = static_cast<const IntervalRunResult&>(result);
+    out.put_vector(r.bins);
+    out.put(r.non_finite);
+    out.put(r.unmatched);
+  }
+  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override {
+    auto r = std::make_unique<IntervalRunResult>();
+    in.get_vector(r->bins);
+    in.get(r->non_finite);
+    in.get(r->unmatched);
     return r;
   }
 

@@ -4,6 +4,7 @@
 #include "annotation_channels.hpp"
 
 #include <trackflow/component.hpp>
+#include <trackflow/run_result_codec.hpp>
 
 #include <cstdint>
 #include <map>
@@ -49,6 +50,10 @@ struct MetricsRunResult final : RunResult {
   double measurement_sq_error = 0.0;
   std::uint64_t measurements_matched = 0, measurements_unmatched = 0;
 };
+
+// A run's records as bytes and back, exactly (mpirun: run_result_codec.hpp).
+void save(const MetricsRunResult& r, ByteWriter& out);
+std::unique_ptr<MetricsRunResult> load(ByteReader& in);
 
 struct StepSums {
   double time = 0.0;  // of the first run that reached this step

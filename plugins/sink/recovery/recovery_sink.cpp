@@ -3,6 +3,7 @@
 #include "truth_match.hpp"
 
 #include <trackflow/plugin.hpp>
+#include <trackflow/run_result_codec.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -18,7 +19,7 @@ struct RecoveryRunResult final : RunResult {
 };
 
 // Estimates are stored during the run and judged in end_run(), when all truth has arrived.
-class RecoverySink final : public Component {
+class RecoverySink final : public Component, public RunResultCodec {
  public:
   RecoverySink(const recovery::Settings& s, double skip_initial, double tolerance)
       : s_(s), skip_initial_(skip_initial), tolerance_(tolerance) {
@@ -72,6 +73,27 @@ class RecoverySink final : public Component {
     }
     r->samples = samples_.size();
     r->stats = recovery::evaluate(samples_, s_);
+    return r;
+  }
+
+  // Per-run statistics cross processes under mpirun (run_result_codec.hpp).
+  void save_run_result(const RunResult& result, ByteWriter& out) const override {
+    const auto& r = static_cast<const RecoveryRunResult&>(result);
+    out.put_vector(r.stats.bursts);
+    out.put(r.stats.sq_error);
+    out.put(r.stats.count);
+    out.put(r.non_finite);
+    out.put(r.unmatched);
+    out.put(r.samples);
+  }
+  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override {
+    auto r = std::make_unique<RecoveryRunResult>();
+    in.get_vector(r->stats.bursts);
+    in.get(r->stats.sq_error);
+    in.get(r->stats.count);
+    in.get(r->non_finite);
+    in.get(r->unmatched);
+    in.get(r->samples);
     return r;
   }
 

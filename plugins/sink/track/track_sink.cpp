@@ -1,6 +1,7 @@
 // Purpose: sink.track — records the truth, measurements (in ENU) and estimates of one chosen run, for the report's track plots.
 #include <trackflow/geometry.hpp>
 #include <trackflow/plugin.hpp>
+#include <trackflow/run_result_codec.hpp>
 
 #include <cmath>
 #include <limits>
@@ -34,7 +35,7 @@ struct TrackRunResult final : RunResult {
 // Records only run `run`; every other run costs one comparison per item. Buffers are sized at
 // the start of the recorded run, so recording does not allocate per item for runs of up to
 // kReserve items per stream.
-class TrackSink final : public Component {
+class TrackSink final : public Component, public RunResultCodec {
  public:
   explicit TrackSink(const Params& p) : run_(static_cast<std::uint64_t>(p.integer("run"))) {}
 
@@ -101,6 +102,25 @@ class TrackSink final : public Component {
     active_ = false;
     auto r = std::make_unique<TrackRunResult>();
     r->streams = streams_;
+    return r;
+  }
+
+  // The recorded run crosses processes under mpirun (run_result_codec.hpp).
+  void save_run_result(const RunResult& result, ByteWriter& out) const override {
+    const auto& r = static_cast<const TrackRunResult&>(result);
+    out.put(static_cast<std::uint64_t>(r.streams.size()));
+    for (const auto& s : r.streams) {
+      out.put(s.kind);
+      out.put_vector(s.points);
+    }
+  }
+  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override {
+    auto r = std::make_unique<TrackRunResult>();
+    r->streams.resize(in.get<std::uint64_t>());
+    for (auto& s : r->streams) {
+      in.get(s.kind);
+      in.get_vector(s.points);
+    }
     return r;
   }
 
