@@ -87,33 +87,45 @@ bool joseph_update_cross(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double, N
       for (int k = i > j ? i : j; k < M; ++k) s += Li[k][i] * Li[k][j];
       Si[i][j] = s;
     }
-  // Row-major working copies (the loops below then run over contiguous short rows): K, and
-  // A = [G, -K], B = [K, PHt] with G = K S - PHt (zero in exact arithmetic: the Joseph
-  // correction), so that the update is P += A B' = G K' - K PHt'.
-  alignas(16) double K[N][M], A[N][2 * M], B[N][2 * M];
-  for (int r = 0; r < N; ++r)
+  // K = PHt S^-1 and G = K S - PHt (zero in exact arithmetic: the Joseph correction), as columns
+  // ([column][row]) so the loops run over the N rows, lane by lane.
+  alignas(16) double Kc[M][N], Gc[M][N];
+  for (int m = 0; m < M; ++m) {
+    for (int r = 0; r < N; ++r) Kc[m][r] = PHt(r, 0) * Si[0][m];
+    for (int k = 1; k < M; ++k)
+      for (int r = 0; r < N; ++r) Kc[m][r] += PHt(r, k) * Si[k][m];
+  }
+  for (int m = 0; m < M; ++m) {
+    for (int r = 0; r < N; ++r) Gc[m][r] = -PHt(r, m);
+    for (int k = 0; k < M; ++k)
+      for (int r = 0; r < N; ++r) Gc[m][r] += Kc[k][r] * S(k, m);
+  }
+  // P += A B' with A = [G, -K], B = [K, PHt] (N x 2M), i.e. G K' - K PHt', on the upper triangle.
+  // Each entry is a dot product of 2M terms, taken two at a time in a vector of two doubles
+  // (GCC/Clang vector extension; the compiler may not reorder a plain sum, so it would not
+  // vectorise it), then mirrored.
+  typedef double Pair __attribute__((vector_size(16)));
+  Pair A[N][M], B[N][M];  // 2M doubles = M pairs per row
+  for (int r = 0; r < N; ++r) {
+    double a[2 * M], b[2 * M];
     for (int m = 0; m < M; ++m) {
-      double s = 0.0;
-      for (int k = 0; k < M; ++k) s += PHt(r, k) * Si[k][m];
-      K[r][m] = s;
+      a[m] = Gc[m][r];
+      a[M + m] = -Kc[m][r];
+      b[m] = Kc[m][r];
+      b[M + m] = PHt(r, m);
     }
-  for (int r = 0; r < N; ++r)
-    for (int m = 0; m < M; ++m) {
-      double g = -PHt(r, m);
-      for (int k = 0; k < M; ++k) g += K[r][k] * S(k, m);
-      A[r][m] = g;
-      A[r][M + m] = -K[r][m];
-      B[r][m] = K[r][m];
-      B[r][M + m] = PHt(r, m);
+    for (int h = 0; h < M; ++h) {
+      A[r][h] = Pair{a[2 * h], a[2 * h + 1]};
+      B[r][h] = Pair{b[2 * h], b[2 * h + 1]};
     }
+  }
   for (int j = 0; j < N; ++j)
     for (int i = 0; i <= j; ++i) {
-      double s = 0.0;
-      for (int k = 0; k < 2 * M; ++k) s += A[i][k] * B[j][k];
-      P(i, j) += s;
+      Pair acc = A[i][0] * B[j][0];
+      for (int h = 1; h < M; ++h) acc += A[i][h] * B[j][h];
+      P(i, j) += acc[0] + acc[1];
+      P(j, i) = P(i, j);
     }
-  for (int j = 0; j < N; ++j)
-    for (int i = 0; i < j; ++i) P(j, i) = P(i, j);
   // NIS = |L^-1 nu|^2; x += K nu.
   nis = 0.0;
   for (int m = 0; m < M; ++m) {
@@ -123,12 +135,12 @@ bool joseph_update_cross(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double, N
   }
   for (int r = 0; r < N; ++r) {
     double s = x(r);
-    for (int m = 0; m < M; ++m) s += K[r][m] * nu(m);
+    for (int m = 0; m < M; ++m) s += Kc[m][r] * nu(m);
     x(r) = s;
   }
   if (K_out)
     for (int r = 0; r < N; ++r)
-      for (int m = 0; m < M; ++m) (*K_out)(r, m) = K[r][m];
+      for (int m = 0; m < M; ++m) (*K_out)(r, m) = Kc[m][r];
   return true;
 }
 

@@ -124,11 +124,44 @@ class SphericalEkf final : public FilterFrontEnd<SphericalEkf> {
     process_noise(x_, unit_Q1_, q_, s_.guard, Q_);  // at the prior state, like F
     propagate(x_, T, s_.guard);
     x_(kTheta) = wrap_angle(x_(kTheta));
-    FP_.noalias() = F_ * P_;
-    P_.noalias() = FP_ * F_.transpose();
+    propagate_covariance();
     P_ += Q_;
     P_ = (0.5 * (P_ + P_.transpose())).eval();
     if (fold_over_zenith(x_, P_)) ++folds_;
+  }
+
+  // P <- F P F' with F = I + E, E the model's few off-diagonal terms (spherical_ca_model.hpp:
+  // the kinematic T, T^2/2 and the angle rows): P + E P, then the same on the columns. The zero
+  // entries of F are skipped, so the products cost a multiple of E's non-zeros (14) instead of
+  // two dense 9x9x9 products; the result is F P F' to rounding.
+  void propagate_covariance() {
+    FP_ = P_;
+    for (int i = 0; i < kDim; ++i)
+      for (int k = 0; k < kDim; ++k)
+        if (k != i && F_(i, k) != 0.0) FP_.row(i) += F_(i, k) * P_.row(k);
+    P_ = FP_;
+    for (int j = 0; j < kDim; ++j)
+      for (int k = 0; k < kDim; ++k)
+        if (k != j && F_(j, k) != 0.0) P_.col(j) += F_(j, k) * FP_.col(k);
+  }
+
+  // H selects [R, θ, φ(, v_r)] with ones (a zero row where the azimuth is not used): P H' is those columns
+  // of P and H P H' their rows, for the Joseph-form update from them (kalman.hpp).
+  template <int M>
+  static void selected_moments(const Matrix& P, const Eigen::Matrix<double, M, kDim>& H,
+                               Eigen::Matrix<double, kDim, M>& PHt, Eigen::Matrix<double, M, M>& HPH) {
+    int col[M];
+    for (int m = 0; m < M; ++m) {
+      col[m] = -1;
+      for (int k = 0; k < kDim; ++k)
+        if (H(m, k) != 0.0) col[m] = k;
+      if (col[m] < 0)
+        PHt.col(m).setZero();
+      else
+        PHt.col(m) = P.col(col[m]);
+    }
+    for (int m = 0; m < M; ++m)
+      for (int n = 0; n < M; ++n) HPH(m, n) = col[m] < 0 ? 0.0 : PHt(col[m], n);
   }
 
   // Linear measurement (eq 3.61-3.63) in SDK order [r, az, el(, rdot)].
@@ -163,9 +196,12 @@ class SphericalEkf final : public FilterFrontEnd<SphericalEkf> {
       nearer_representation<M>(H, drop_azimuth, z, R);
     Eigen::Matrix<double, M, 1> nu = z - H * x_;
     nu(1) = drop_azimuth ? 0.0 : wrap_angle(nu(1));
+    Eigen::Matrix<double, kDim, M> PHt;
     MatM S;
+    selected_moments<M>(P_, H, PHt, S);
+    S += R;
     double nis = 0.0;
-    if (joseph_update<kDim, M>(x_, P_, nu, H, R, S, nis)) {
+    if (joseph_update_cross<kDim, M>(x_, P_, nu, PHt, S, nis)) {
       x_(kTheta) = wrap_angle(x_(kTheta));
       if (fold_over_zenith(x_, P_)) ++folds_;
       accept_update<M>(nu, S, nis);
@@ -200,7 +236,9 @@ class SphericalEkf final : public FilterFrontEnd<SphericalEkf> {
     MatM R_fold = R;
     R_fold.row(2) *= -1.0;
     R_fold.col(2) *= -1.0;
-    const MatM HPH = H * P_ * H.transpose();
+    Eigen::Matrix<double, kDim, M> PHt;
+    MatM HPH;
+    selected_moments<M>(P_, H, PHt, HPH);
     auto nis = [&](const VecM& zz, const MatM& RR) {
       VecM nu = zz - H * x_;
       nu(1) = drop_azimuth ? 0.0 : wrap_angle(nu(1));
@@ -237,9 +275,8 @@ class SphericalEkf final : public FilterFrontEnd<SphericalEkf> {
     e.covariance = P_;
     e.enu = to_enu(x_, convention_, &J_enu_);
     e.enu.head<3>() += sensor_;
-    JP_.noalias() = J_enu_ * P_;
-    Mat6 C;
-    C.noalias() = JP_ * J_enu_.transpose();
+    JP_ = J_enu_.lazyProduct(P_);  // coefficient-wise products: no general matrix-product kernel for 6x9
+    Mat6 C = JP_.lazyProduct(J_enu_.transpose());
     e.enu_covariance = 0.5 * (C + C.transpose());
   }
 

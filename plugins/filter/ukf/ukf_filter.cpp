@@ -91,8 +91,8 @@ class UnscentedKalmanFilter final
     typename ukf::SphericalNearCentre<M>::template Batch<2 * N> points;
     int slot[N];  // points.z[slot[j]] = h(x + c L_j), points.z[slot[j] + 1] = h(x - c L_j); -1: h(x)
     for (int j = 0; j < N; ++j) {
-      bool moves = false;
-      for (int k = 0; k < kRead; ++k) moves |= L(idx_[k], j) != 0.0;
+      bool moves = false;  // L is lower triangular: only rows from j on can be non-zero
+      for (int k = 0; k < kRead && !moves; ++k) moves = idx_[k] >= j && L(idx_[k], j) != 0.0;
       slot[j] = moves ? points.count : -1;
       if (!moves) continue;
       for (const double sign : {c, -c}) {
@@ -129,20 +129,16 @@ class UnscentedKalmanFilter final
       ++spread_clamped_count_;
     }
     // H = G' L^-1 is never formed: P H' = L L' H' = L G (L lower triangular), H P H' = G' G.
-    Eigen::Matrix<double, N, M> PHt;
+    // Column by column (P H')(:, k) = sum_j G(j, k) L(:, j): whole columns of L (zero above the
+    // diagonal), so the loops over the N rows vectorise.
+    Eigen::Matrix<double, N, M> PHt = Eigen::Matrix<double, N, M>::Zero();
     for (int k = 0; k < M; ++k)
-      for (int r = 0; r < N; ++r) {
-        double s = 0.0;
-        for (int j = 0; j <= r; ++j) s += L(r, j) * ut.G(j, k);
-        PHt(r, k) = s;
+      for (int j = 0; j < N; ++j) {
+        const double g = ut.G(j, k);
+        for (int r = 0; r < N; ++r) PHt(r, k) += L(r, j) * g;
       }
-    MatM S;
-    for (int k = 0; k < M; ++k)
-      for (int l = k; l < M; ++l) {
-        double s = R(l, k);
-        for (int j = 0; j < N; ++j) s += ut.G(j, l) * ut.G(j, k);
-        S(l, k) = s;
-      }
+    MatM S = R;
+    S.noalias() += ut.G.transpose().lazyProduct(ut.G);
     double nis = 0.0;
     if (joseph_update_cross<N, M>(x_, P_, nu, PHt, S, nis)) {
       this->template accept_update<M>(nu, S, nis);

@@ -33,22 +33,24 @@ struct ScaledWeights {
 };
 
 // Lower Cholesky factor L L' = A from A's lower triangle (as Eigen::LLT reads it); the upper
-// triangle of L is zero. False when a pivot is not positive (or NaN). Plain loops over fixed
-// sizes: for a 9 x 9 P this takes about half the time of Eigen::LLT's blocked code.
+// triangle of L is zero. False when a pivot is not positive (or NaN). Column by column, each
+// column as A's minus multiples of the earlier ones over all N rows (the rows above the diagonal
+// are computed and dropped): loops of fixed length that vectorise, about half the time of
+// Eigen::LLT's blocked code for a 9 x 9.
 template <int N>
 bool cholesky_lower(const Eigen::Matrix<double, N, N>& A, Eigen::Matrix<double, N, N>& L) {
   L.setZero();
   for (int j = 0; j < N; ++j) {
-    double d = A(j, j);
-    for (int k = 0; k < j; ++k) d -= L(j, k) * L(j, k);
-    if (!(d > 0.0)) return false;
-    const double ljj = std::sqrt(d), inv = 1.0 / ljj;
-    L(j, j) = ljj;
-    for (int i = j + 1; i < N; ++i) {
-      double s = A(i, j);
-      for (int k = 0; k < j; ++k) s -= L(i, k) * L(j, k);
-      L(i, j) = s * inv;
+    alignas(16) double c[N];
+    for (int i = 0; i < N; ++i) c[i] = A(i, j);
+    for (int k = 0; k < j; ++k) {
+      const double l = L(j, k);
+      for (int i = 0; i < N; ++i) c[i] -= L(i, k) * l;
     }
+    if (!(c[j] > 0.0)) return false;
+    const double ljj = std::sqrt(c[j]), inv = 1.0 / ljj;
+    L(j, j) = ljj;
+    for (int i = j + 1; i < N; ++i) L(i, j) = c[i] * inv;
   }
   return true;
 }
@@ -60,7 +62,9 @@ bool cholesky_lower(const Eigen::Matrix<double, N, N>& A, Eigen::Matrix<double, 
 // be factored (non-finite, or indefinite beyond 1e-4 of its scale).
 template <int N>
 double guarded_cholesky(Eigen::Matrix<double, N, N>& P, Eigen::Matrix<double, N, N>& L) {
-  if (!P.allFinite()) return -1.0;
+  // Not finite: a NaN or an infinity anywhere makes the sum NaN or infinite (as would entries
+  // summing beyond 1.8e308, no covariance of a track).
+  if (!std::isfinite(P.sum())) return -1.0;
   if (cholesky_lower<N>(P, L)) return 0.0;
   P = (0.5 * (P + P.transpose())).eval();
   const double scale = P.diagonal().cwiseAbs().maxCoeff();
