@@ -1,6 +1,6 @@
 // Purpose: benchmark: per-step cost of the spherical-measurement filters (filter.ekf, filter.ukf, filter.ekf_spherical) on one pre-generated launch track.
 //
-// Usage: trackflow-bench-filters [--reps N] [--rounds R]. Single thread. sim.trajectory (KSLV-I
+// Usage: trackflow-bench-filters [--reps N] [--rounds R] [--plugins DIR]. Single thread. sim.trajectory (KSLV-I
 // profile, 40 Hz, 540 s) and sim.radar (Table-4 noise with range rate, radar 100 km from the pad)
 // generate one measurement sequence; each filter then runs over it through its plugin (virtual
 // call, Estimate formed and read by one consumer), N passes per round, the filters taking turns
@@ -124,12 +124,14 @@ void passes(Component& f, const Track& track, int reps) {
 
 int main(int argc, char** argv) {
   int reps = 5, rounds = 7;
+  std::string plugin_dir = TRACKFLOW_BENCH_PLUGIN_DIR;  // --plugins: another build's, for before/after
   for (int i = 1; i + 1 < argc; i += 2) {
+    if (!std::strcmp(argv[i], "--plugins")) plugin_dir = argv[i + 1];
     if (!std::strcmp(argv[i], "--reps")) reps = std::atoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--rounds")) rounds = std::atoi(argv[i + 1]);
   }
   host::PluginRegistry reg;
-  reg.load_directories({TRACKFLOW_BENCH_PLUGIN_DIR});
+  reg.load_directories({plugin_dir});
   const Track track = launch_track(reg);
   if (track.measurements.size() != track.truth.size()) {
     std::fprintf(stderr, "expected one measurement per truth sample\n");

@@ -1,15 +1,18 @@
 // Purpose: benchmark: per-step time of filter.ekf (Singer) vs filter.gain_transform on paper 002's circle, and the multiplication counts of each step.
 //
-// Usage: trackflow-bench-gain-transform [--reps N] [--trials N]. Single thread; each time is the
-// fastest of N trials (default 5), which filters out other load on a shared machine. On one pre-generated measurement
+// Usage: trackflow-bench-gain-transform [--reps N] [--trials N] [--plugins DIR]. Single thread; the
+// contenders take turns for N trials (default 5) and each keeps its best, by CPU time (this process
+// on its core) and by wall time, so other load on a shared machine affects them alike. On one
+// pre-generated measurement
 // sequence (paper 002 scenario 1: 40 Hz, 1500 m circle around the radar at 150 m altitude,
 // 200 m/s, sigma_r 15 m, 3 mrad, one full turn = 1885 measurements), repeated N times:
 //   (1) filter.ekf (motion: singer) and filter.gain_transform through their plugins (virtual call,
-//       Estimate filled, no consumers), the ratio of their step times;
+//       Estimate formed and read by one consumer), the ratio of their step times;
 //   (2) the same two algorithms as plain loops without the plugin shell: the gain-transform core
 //       and a lean EKF (structured prediction, H-sparse symmetric update), to separate the
 //       algorithm from filter.ekf's dense Joseph-form implementation;
 //   (3) multiplications per step, counted with a counting scalar (operation_counts.hpp).
+#include "bench_common.hpp"
 #include "operation_counts.hpp"
 
 #include <trackflow/geometry.hpp>
@@ -57,34 +60,28 @@ std::vector<Measurement> circle_measurements() {
 
 double seconds_since(Clock::time_point t0) { return std::chrono::duration<double>(Clock::now() - t0).count(); }
 
-// Microseconds per measurement through a plugin; the first pass warms up, the fastest trial counts.
-double plugin_step_us(const host::PluginRegistry& reg, const std::string& type, const std::string& params,
-                      const std::vector<Measurement>& ms, int reps, int trials, double& checksum) {
-  const auto* t = reg.find(type);
-  if (!t) {
-    std::fprintf(stderr, "plugin type %s not found in %s\n", type.c_str(), TRACKFLOW_BENCH_PLUGIN_DIR);
-    std::exit(2);
-  }
-  const Params p = host::validate_params(t->decl.params, host::load_yaml_string(params, "bench"), "f", {});
-  auto f = reg.create(*t, p);
-  struct Last : Component {
-    double x = 0;
-    void on_estimate(const Estimate& e, int) override { x = e.state(0); }
-  } last;
-  const Link link{&last, 0, 0xFF};
-  f->out.connect(&link, 1);
+// A plugin and the consumer that reads each of its estimates (so the whole Estimate is formed).
+struct PluginUnderTest {
+  std::shared_ptr<Component> filter;
+  trackflow::bench::Consumer consumer;
+  Link link{};
+};
+
+std::unique_ptr<PluginUnderTest> plugin(const host::PluginRegistry& reg, const std::string& type,
+                                        const std::string& params) {
+  auto p = std::make_unique<PluginUnderTest>();
+  p->filter = trackflow::bench::make(reg, type, params);
+  p->link = {&p->consumer, 0, 0xFF};
+  p->filter->out.connect(&p->link, 1);
+  return p;
+}
+
+void passes(Component& f, const std::vector<Measurement>& ms, int reps) {
   Diagnostics d;
-  double us = 1e300;
-  for (int pass = 0; pass <= trials; ++pass) {
-    const auto t0 = Clock::now();
-    for (int rep = 0; rep < reps; ++rep) {
-      f->start_run({static_cast<std::uint64_t>(rep), 1, &d});
-      for (const auto& m : ms) f->on_measurement(m, 0);
-      checksum += last.x;
-    }
-    if (pass > 0) us = std::min(us, 1e6 * seconds_since(t0) / (static_cast<double>(reps) * ms.size()));
+  for (int rep = 0; rep < reps; ++rep) {
+    f.start_run({static_cast<std::uint64_t>(rep), 1, &d});
+    for (const auto& m : ms) f.on_measurement(m, 0);
   }
-  return us;
 }
 
 SingerAxis<double> singer_axis() {
@@ -191,33 +188,50 @@ double fastest(int trials, F&& f) {
 
 int main(int argc, char** argv) {
   int reps = 300, trials = 5;
+  std::string plugin_dir = TRACKFLOW_BENCH_PLUGIN_DIR;  // --plugins: another build's, for before/after
   for (int i = 1; i + 1 < argc; i += 2) {
+    if (!std::strcmp(argv[i], "--plugins")) plugin_dir = argv[i + 1];
     if (!std::strcmp(argv[i], "--reps")) reps = std::atoi(argv[i + 1]);
     if (!std::strcmp(argv[i], "--trials")) trials = std::max(1, std::atoi(argv[i + 1]));
   }
   host::PluginRegistry reg;
-  reg.load_directories({TRACKFLOW_BENCH_PLUGIN_DIR});
+  reg.load_directories({plugin_dir});
   const auto ms = circle_measurements();
   double checksum = 0;
-  const double ekf_us = plugin_step_us(reg, "filter.ekf", "{ motion: singer, singer_alpha: 1 1/s, singer_sigma: 20 m/s2 }",
-                                       ms, reps, trials, checksum);
-  const double gt_us = plugin_step_us(reg, "filter.gain_transform", "{ singer_alpha: 1 1/s, singer_sigma: 20 m/s2 }",
-                                      ms, reps, trials, checksum);
+  auto ekf_plugin = plugin(reg, "filter.ekf", "{ motion: singer, singer_alpha: 1 1/s, singer_sigma: 20 m/s2 }");
+  auto gt_plugin = plugin(reg, "filter.gain_transform", "{ singer_alpha: 1 1/s, singer_sigma: 20 m/s2 }");
+  // The two plugins take turns (and the two plain loops), each keeping its best trial, so other
+  // load on a shared machine affects them alike.
+  const double steps = static_cast<double>(reps) * ms.size(), plain_steps = static_cast<double>(reps) * (ms.size() - 2);
+  trackflow::bench::Rate ekf_rate, gt_rate;
+  passes(*ekf_plugin->filter, ms, reps / 10 + 1);
+  passes(*gt_plugin->filter, ms, reps / 10 + 1);
+  for (int t = 0; t < trials; ++t) {
+    ekf_rate.add(steps, trackflow::bench::time_it([&] { passes(*ekf_plugin->filter, ms, reps); }));
+    gt_rate.add(steps, trackflow::bench::time_it([&] { passes(*gt_plugin->filter, ms, reps); }));
+  }
   plain_gain_transform_us(ms, reps / 10 + 1, checksum);  // warm-up
-  const double plain_gt_us = fastest(trials, [&] { return plain_gain_transform_us(ms, reps, checksum); });
   plain_lean_ekf_us(ms, reps / 10 + 1, checksum);
-  const double plain_lean_us = fastest(trials, [&] { return plain_lean_ekf_us(ms, reps, checksum); });
+  trackflow::bench::Rate plain_gt, plain_lean;
+  for (int t = 0; t < trials; ++t) {
+    plain_gt.add(plain_steps, trackflow::bench::time_it([&] { plain_gain_transform_us(ms, reps, checksum); }));
+    plain_lean.add(plain_steps, trackflow::bench::time_it([&] { plain_lean_ekf_us(ms, reps, checksum); }));
+  }
+  checksum += ekf_plugin->consumer.sum + gt_plugin->consumer.sum;
 
-  std::printf("paper 002 circle, %zu measurements x %d repetitions, fastest of %d trials, 1 thread\n", ms.size(), reps,
-              trials);
-  std::printf("per step, through the plugin (virtual call, Estimate filled, no consumers):\n");
-  std::printf("  filter.ekf (singer, Joseph form)          %8.3f us\n", ekf_us);
-  std::printf("  filter.gain_transform                     %8.3f us\n", gt_us);
-  std::printf("  speed-up ekf / gain_transform             %8.2f x   (aim >= 1.5)\n", ekf_us / gt_us);
-  std::printf("per step, plain loops (no plugin shell, no published covariance):\n");
-  std::printf("  lean EKF (structured F, H-sparse update)  %8.3f us\n", plain_lean_us);
-  std::printf("  gain-transform core                       %8.3f us\n", plain_gt_us);
-  std::printf("  speed-up lean EKF / gain-transform core   %8.2f x\n", plain_lean_us / plain_gt_us);
+  std::printf("paper 002 circle, %zu measurements x %d repetitions, best of %d alternating trials, 1 thread\n",
+              ms.size(), reps, trials);
+  std::printf("us per step                                     CPU time   wall time\n");
+  std::printf("through the plugin (virtual call, Estimate formed and read by a consumer):\n");
+  std::printf("  filter.ekf (singer, Joseph form)             %8.3f    %8.3f\n", 1e6 / ekf_rate.cpu, 1e6 / ekf_rate.wall);
+  std::printf("  filter.gain_transform                        %8.3f    %8.3f\n", 1e6 / gt_rate.cpu, 1e6 / gt_rate.wall);
+  std::printf("  speed-up ekf / gain_transform                %8.2f x  %8.2f x  (aim >= 1.5)\n", gt_rate.cpu / ekf_rate.cpu,
+              gt_rate.wall / ekf_rate.wall);
+  std::printf("plain loops (no plugin shell, no published covariance):\n");
+  std::printf("  lean EKF (structured F, H-sparse update)     %8.3f    %8.3f\n", 1e6 / plain_lean.cpu, 1e6 / plain_lean.wall);
+  std::printf("  gain-transform core                          %8.3f    %8.3f\n", 1e6 / plain_gt.cpu, 1e6 / plain_gt.wall);
+  std::printf("  speed-up lean EKF / gain-transform core      %8.2f x  %8.2f x\n", plain_gt.cpu / plain_lean.cpu,
+              plain_gt.wall / plain_lean.wall);
   std::printf("\nmultiplications per step (counting scalar; divisions and sqrt/atan2/hypot/exp not included):\n");
   std::printf("  %-40s %6s %6s %6s %6s   %6s   %6s   %6s\n", "", "P pred", "lin", "K+P up", "state", "GAIN", "FILTER",
               "publ.");

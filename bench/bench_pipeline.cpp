@@ -1,6 +1,7 @@
 // Purpose: benchmark: the quickstart pipeline against the same computation as a plain loop; one 6-state CV Kalman step through filter.kalman, as plain fixed-size Eigen, and in OpenCV's cv::KalmanFilter side by side.
 //
-// Usage: trackflow-bench [--runs N] [--reps N] [--rounds R] [--only pipeline|kalman]. Single thread.
+// Usage: trackflow-bench [--runs N] [--reps N] [--rounds R] [--only pipeline|kalman] [--plugins DIR].
+// Single thread.
 // Every section alternates its contenders for R rounds (default 5) and keeps each one's best
 // round, so other load on a shared machine affects them alike; rates are given per second of
 // CPU time (this process on its core) and of wall time.
@@ -401,15 +402,16 @@ void pipeline_section(const host::PluginRegistry& reg, int runs, int rounds) {
 
 int main(int argc, char** argv) {
   int runs = 400, reps = 400, rounds = 5;
-  std::string only;
+  std::string only, plugin_dir = TRACKFLOW_BENCH_PLUGIN_DIR;  // --plugins: another build's, for before/after
   for (int i = 1; i + 1 < argc; i += 2) {
+    if (!std::strcmp(argv[i], "--plugins")) plugin_dir = argv[i + 1];
     if (!std::strcmp(argv[i], "--runs")) runs = std::max(1, std::atoi(argv[i + 1]));
     if (!std::strcmp(argv[i], "--reps")) reps = std::max(1, std::atoi(argv[i + 1]));
     if (!std::strcmp(argv[i], "--rounds")) rounds = std::max(1, std::atoi(argv[i + 1]));
     if (!std::strcmp(argv[i], "--only")) only = argv[i + 1];
   }
   host::PluginRegistry reg;
-  reg.load_directories({TRACKFLOW_BENCH_PLUGIN_DIR});
+  reg.load_directories({plugin_dir});
   if (only.empty() || only == "pipeline") pipeline_section(reg, runs, rounds);
   if (only.empty()) std::printf("\n");
   if (only.empty() || only == "kalman") kalman_section(reg, reps, rounds);

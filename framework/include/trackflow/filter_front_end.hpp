@@ -77,12 +77,12 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
       return;
     }
     const int dim = dimension(m);
-    if (well_formed && n >= dim) R_ = m.covariance.topLeftCorner(dim, dim);
+    if (well_formed && n >= dim) copy_R(m, dim);
     before_update(m);  // adapters may replace R_ and the process noise
     if (m.valid && (R_.rows() < dim || R_.cols() < dim))
       throw DataError(who() + ": an adapter left a " + std::to_string(R_.rows()) + "x" + std::to_string(R_.cols()) +
                       " R for a " + std::to_string(dim) + "-element measurement");
-    const bool usable = m.valid && m.value.head(dim).allFinite() && R_.topLeftCorner(dim, dim).allFinite();
+    const bool usable = m.valid && finite(m, dim);
     if (!m.valid) {
       ++run_.coasted;
     } else if (!usable) {
@@ -210,8 +210,10 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
   template <int M>
   void accept_update(const Eigen::Matrix<double, M, 1>& nu, const Eigen::Matrix<double, M, M>& S, double nis) {
     est_.updated = true;
-    est_.innovation = nu;
-    est_.innovation_covariance = S;
+    est_.innovation.resize(M);
+    est_.innovation.template head<M>() = nu;
+    est_.innovation_covariance.resize(M, M);
+    est_.innovation_covariance.template topLeftCorner<M, M>() = S;
     est_.nis = nis;
   }
 
@@ -237,6 +239,22 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
       throw DataError(who() + ": range_rate: use, but the measurement at t=" + std::to_string(m.time) +
                       " s has no range rate (range_rate: auto accepts both)");
     derived().check_measurement(m);
+  }
+
+  // The measurement's R (3x3 or 4x4) and the finiteness of what the update will use, as
+  // fixed-size copies and checks (the items are sized at run time).
+  void copy_R(const Measurement& m, int dim) {
+    R_.resize(dim, dim);
+    if (dim == 4)
+      R_.template topLeftCorner<4, 4>() = m.covariance.template topLeftCorner<4, 4>();
+    else
+      R_.template topLeftCorner<3, 3>() = m.covariance.template topLeftCorner<3, 3>();
+  }
+  bool finite(const Measurement& m, int dim) const {
+    if (m.value.size() < dim || R_.rows() < dim || R_.cols() < dim) return false;
+    if (dim == 4)
+      return m.value.template head<4>().allFinite() && R_.template topLeftCorner<4, 4>().allFinite();
+    return m.value.template head<3>().allFinite() && R_.template topLeftCorner<3, 3>().allFinite();
   }
 
   int dimension(const Measurement& m) const {

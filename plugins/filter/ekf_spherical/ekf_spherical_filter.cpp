@@ -271,8 +271,10 @@ class SphericalEkf final : public FilterFrontEnd<SphericalEkf> {
 
   // ENU block for metrics: p = sensor + R e_r, v = v_r e_r + v_h e_θ + v_v e_φ, cov J P J'.
   void fill_estimate(Estimate& e) {
-    e.state = x_;
-    e.covariance = P_;
+    e.state.resize(kDim);
+    e.state.head<kDim>() = x_;
+    e.covariance.resize(kDim, kDim);
+    e.covariance.topLeftCorner<kDim, kDim>() = P_;
     e.enu = to_enu(x_, convention_, &J_enu_);
     e.enu.head<3>() += sensor_;
     JP_ = J_enu_.lazyProduct(P_);  // coefficient-wise products: no general matrix-product kernel for 6x9

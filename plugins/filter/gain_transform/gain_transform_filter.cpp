@@ -196,7 +196,8 @@ class GainTransformFilter final : public FilterFrontEnd<GainTransformFilter> {
     for (int i = 0; i < 9; ++i) e.state(i) = x_[i];
     Eigen::Matrix<double, 9, 9> P;
     enu_covariance(B_, frame_.u, P);
-    e.covariance = P;
+    e.covariance.resize(9, 9);
+    e.covariance.topLeftCorner<9, 9>() = P;
     constexpr int kIndex[6] = {state_index(0, 0), state_index(1, 0), state_index(2, 0),
                                state_index(0, 1), state_index(1, 1), state_index(2, 1)};
     for (int j = 0; j < 6; ++j) {

@@ -197,8 +197,10 @@ class KalmanFilter final : public FilterFrontEnd<KalmanFilter<Model>> {
   }
 
   void fill_estimate(Estimate& e) const {
-    e.state = x_;
-    e.covariance = P_;
+    e.state.resize(N);
+    e.state.template head<N>() = x_;
+    e.covariance.resize(N, N);
+    e.covariance.template topLeftCorner<N, N>() = P_;
     for (int i = 0; i < 6; ++i) {
       e.enu(i) = x_(idx_[i]);
       for (int j = 0; j < 6; ++j) e.enu_covariance(i, j) = P_(idx_[i], idx_[j]);
