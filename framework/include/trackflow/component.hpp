@@ -224,6 +224,8 @@ class BOOST_SYMBOL_VISIBLE Filter : public Component {
   void before_update(const Measurement& m) {
     for (int i = 0; i < adapter_count_; ++i) adapters_[i]->before_update(m, *this);
   }
+  // Whether anything sees the estimates: a consumer downstream or an adapter's after_update.
+  bool observed() const { return adapter_count_ > 0 || out.count() > 0; }
   // Stamps the adapters' annotations on `e`, lets adapters see the result, then sends it on.
   void publish(const Measurement& m, Estimate& e) {
     e.annotation_count = annotation_count_;

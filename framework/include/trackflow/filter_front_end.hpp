@@ -273,10 +273,12 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
     est_.nis = 0.0;
   }
 
+  // The published state and covariance are formed only when something sees them (a filter node
+  // without consumers and adapters forms nothing); the filter's own state is the same either way.
   void publish_state(const Measurement& m) {
     est_.time = m.time;
     est_.initialised = true;
-    derived().fill_estimate(est_);
+    if (observed()) derived().fill_estimate(est_);
     publish(m, est_);
   }
 
