@@ -98,7 +98,7 @@ class SphericalNearCentre {
     }
     const double x0 = d0_.x(), y0 = d0_.y(), z0 = d0_.z(), rho0 = rho0_;
     const double sign = c_ == AzimuthConvention::NorthClockwise ? 1.0 : -1.0;
-    double r[K], rho[K], az_num[K], az_den[K], el_num[K], el_den[K], rr[K];
+    double r[K], rho[K], az_num[K], az_den[K], el_num[K], el_den[K], az_t[K], el_t[K], rr[K];
     for (int k = 0; k < n; ++k) {
       const double ex = b.ex[k], ey = b.ey[k], ez = b.ez[k];
       const double x = x0 + ex, y = y0 + ey, z = z0 + ez;
@@ -110,11 +110,19 @@ class SphericalNearCentre {
       // rho - rho0 directly: its rounding (an ulp of rho) moves the elevation by ~1e-16 rad.
       el_num[k] = ez * rho0 - (rho[k] - rho0) * z0;
       el_den[k] = rho[k] * rho0 + z * z0;
-      if constexpr (M == 4) rr[k] = (x * (v0_.x() + b.fx[k]) + y * (v0_.y() + b.fy[k]) + z * (v0_.z() + b.fz[k])) / r[k];
+      // One division for the three quotients (1/a = b c / (a b c)): divisions are what the
+      // sigma points wait for, and a b c stays far from overflow (r^5 < 1e40 for any radar range).
+      const double inv = 1.0 / (az_den[k] * el_den[k] * r[k]);
+      const double t_az = az_num[k] * (el_den[k] * r[k] * inv), t_el = el_num[k] * (az_den[k] * r[k] * inv);
+      az_t[k] = t_az;
+      el_t[k] = t_el;
+      if constexpr (M == 4)
+        rr[k] = (x * (v0_.x() + b.fx[k]) + y * (v0_.y() + b.fy[k]) + z * (v0_.z() + b.fz[k])) *
+                (az_den[k] * el_den[k] * inv);
     }
     double az[K], el[K];
-    series_atan(az_num, az_den, az, n);
-    series_atan(el_num, el_den, el, n);
+    series_atan(az_t, az, n);
+    series_atan(el_t, el, n);
     for (int k = 0; k < n; ++k) {
       const bool ok = rho[k] > 0.0 && az_den[k] > 0.0 && std::fabs(az_num[k]) <= 0.125 * az_den[k] && el_den[k] > 0.0 &&
                       std::fabs(el_num[k]) <= 0.125 * el_den[k] && (M == 3 || r[k] > 0.0);
@@ -130,10 +138,11 @@ class SphericalNearCentre {
   }
 
  private:
-  // small_atan's series over arrays (no check: the caller redoes the points outside its range).
-  static void series_atan(const double* num, const double* den, double* out, int n) {
+  // small_atan's series over arrays of t = num / den (no check: the caller redoes the points
+  // outside its range).
+  static void series_atan(const double* t_in, double* out, int n) {
     for (int k = 0; k < n; ++k) {
-      const double t = num[k] / den[k], t2 = t * t;
+      const double t = t_in[k], t2 = t * t;
       double p = 1.0 / 17.0;
       p = p * t2 - 1.0 / 15.0;
       p = p * t2 + 1.0 / 13.0;
