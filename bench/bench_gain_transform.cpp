@@ -236,7 +236,7 @@ int main(int argc, char** argv) {
   std::printf("  %-40s %6s %6s %6s %6s   %6s   %6s   %6s\n", "", "P pred", "lin", "K+P up", "state", "GAIN", "FILTER",
               "publ.");
   const StepCounts ekf = count_filter_ekf_step(), lean = count_lean_ekf_step(), gt = count_gain_transform_step();
-  print_counts("filter.ekf (as implemented)", ekf);
+  print_counts("filter.ekf before issue 12 (dense)", ekf);
   print_counts("lean EKF", lean);
   print_counts("gain transform (filter.gain_transform)", gt);
   std::printf("  GAIN = P pred + lin + K+P up (paper 002's 'gain computation'); FILTER = GAIN + state\n");

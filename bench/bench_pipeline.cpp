@@ -80,7 +80,8 @@ double plain_loop(int runs, double& checksum) {
       const Mat3 J = spherical_to_enu_jacobian(r, az, el, AzimuthConvention::NorthClockwise);
       Mat3 R = J * Vec3(sr * sr, sa * sa, se * se).asDiagonal() * J.transpose();
       R = 0.5 * (R + R.transpose()).eval();
-      st.meas_sq += (z - p).squaredNorm();
+      // sink.metrics scores measurements from the first estimate's time on (step 1).
+      if (k > 0) st.meas_sq += (z - p).squaredNorm();
       if (k == 0) {
         z1 = z;
         R1 = R;
@@ -162,7 +163,7 @@ double plain_loop(int runs, double& checksum) {
     }
   }
   const double position_rmse = std::sqrt((sq[0] + sq[1] + sq[2]) / n);
-  const double measurement_rmse = std::sqrt(meas_sq / (static_cast<double>(runs) * steps));
+  const double measurement_rmse = std::sqrt(meas_sq / (static_cast<double>(runs) * (steps - 1)));
   const double outputs[] = {position_rmse,
                             std::sqrt((sq[3] + sq[4] + sq[5]) / n),
                             std::sqrt(sq[0] / n), std::sqrt(sq[1] / n), std::sqrt(sq[2] / n),

@@ -117,7 +117,8 @@ inline Eigen::Matrix<Counted, 9, 9> ekf_covariance() {
 }
 }  // namespace detail
 
-// filter.ekf's arithmetic for the Singer motion with [r, az, el] (ekf_operation_replica.hpp).
+// filter.ekf's arithmetic before issue 12 (dense 9x9 Joseph form; the plugin now runs the structured
+// update of kalman.hpp) for the Singer motion with [r, az, el] (ekf_operation_replica.hpp).
 inline StepCounts count_filter_ekf_step() {
   using S = Counted;
   using namespace replica;
