@@ -141,7 +141,7 @@ ExpectConfig parse_expect(const std::string& key, const SourceLoc& key_loc, cons
   e.node = key.substr(0, dot);
   e.metric = key.substr(dot + 1);
   if (v.kind != Value::Kind::Map || v.entries.empty())
-    throw ConfigError("expect '" + key + "' must be a map such as { max: 25 } or { within_band: 0.95 }", v.loc);
+    throw ConfigError("expect '" + key + "' must be a map such as { max: 25 } or { within_band: 0.95 }, or a list of them", v.loc);
   static const std::vector<std::string> ops = {"min",       "max",       "within_band",  "outside_band", "equals",
                                                "tolerance", "less_than", "greater_than", "ratio_to"};
   reject_unknown_keys(v, ops, "expect '" + key + "'");
@@ -303,23 +303,36 @@ PipelineConfig parse_pipeline(const Value& root, const std::string& file, const 
   if (const Value* ex = root.find("expect")) {
     if (ex->kind != Value::Kind::Map) throw ConfigError("'expect' must be a map of <node>.<metric>: {check}", ex->loc);
     for (size_t i = 0; i < ex->entries.size(); ++i) {
-      const auto& [key, val] = ex->entries[i];
-      // { min: a, max: b } is two checks.
-      if (val.kind == Value::Kind::Map && val.find("min") && val.find("max")) {
-        for (const char* op : {"min", "max"}) {
-          Value one;
-          one.kind = Value::Kind::Map;
-          one.loc = val.loc;
-          one.entries.emplace_back(op, *val.find(op));
-          one.key_locs.push_back(val.key_loc(op));
-          if (const Value* r = val.find("ratio_to")) {
-            one.entries.emplace_back("ratio_to", *r);
-            one.key_locs.push_back(val.key_loc("ratio_to"));
-          }
-          cfg.expects.push_back(parse_expect(key, ex->key_locs[i], one));
-        }
+      const auto& [key, entry] = ex->entries[i];
+      // A list of check maps puts several checks on one metric, e.g. an absolute bound and a
+      // comparison: [{ max: 5 }, { less_than: baseline.position_rmse }].
+      std::vector<const Value*> checks;
+      if (entry.kind == Value::Kind::List) {
+        if (entry.items.empty())
+          throw ConfigError("expect '" + key + "': an empty list of checks", entry.loc);
+        for (const Value& item : entry.items) checks.push_back(&item);
       } else {
-        cfg.expects.push_back(parse_expect(key, ex->key_locs[i], val));
+        checks.push_back(&entry);
+      }
+      for (const Value* check : checks) {
+        const Value& val = *check;
+        // { min: a, max: b } is two checks.
+        if (val.kind == Value::Kind::Map && val.find("min") && val.find("max")) {
+          for (const char* op : {"min", "max"}) {
+            Value one;
+            one.kind = Value::Kind::Map;
+            one.loc = val.loc;
+            one.entries.emplace_back(op, *val.find(op));
+            one.key_locs.push_back(val.key_loc(op));
+            if (const Value* r = val.find("ratio_to")) {
+              one.entries.emplace_back("ratio_to", *r);
+              one.key_locs.push_back(val.key_loc("ratio_to"));
+            }
+            cfg.expects.push_back(parse_expect(key, ex->key_locs[i], one));
+          }
+        } else {
+          cfg.expects.push_back(parse_expect(key, ex->key_locs[i], val));
+        }
       }
     }
   }
