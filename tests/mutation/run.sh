@@ -66,8 +66,8 @@ start=$(date +%s)
 ls "$work/rows" | xargs -P "$jobs" -I{} bash -c 'run_one {}'
 elapsed=$(( $(date +%s) - start ))
 
-printf '%-26s %-52s %-8s %s\n' pipeline breakage result "failed checks (first 3)"
-printf '%-26s %-52s %-8s %s\n' -------- -------- ------ -----------------------
+printf '%-24s %-50s %-7s %s\n' pipeline breakage result "failed checks (first 3)"
+printf '%-24s %-50s %-7s %s\n' -------- -------- ------ -----------------------
 caught=0
 missed=0
 for r in $(ls "$work/rows"); do
@@ -79,7 +79,7 @@ for r in $(ls "$work/rows"); do
     0) result=MISSED; missed=$((missed + 1)); checks="(every check passed)" ;;
     *) result="ERROR"; missed=$((missed + 1)); checks="exit $rc: $(grep -m1 -iE 'error|refused' "$work/log/$r" | cut -c1-100)" ;;
   esac
-  printf '%-26s %-52s %-8s %s\n' "${f[0]}" "${f[1]}" "$result" "$checks"
+  printf '%-24s %-50s %-7s %s\n' "${f[0]}" "${f[1]}" "$result" "$checks"
 done
 echo
 echo "$caught of $n breakages caught, $missed not; $jobs in parallel, ${elapsed} s"
