@@ -151,7 +151,7 @@ TEST_CASE("KSLV-I velocity and acceleration are derivatives") {
     // Across each interior knot the velocity is continuous (a jump would show at once; over 2e-7 s
     // the acceleration moves it by < 1e-5). The acceleration is continuous where the monotone
     // limiter left the spline alone (the 229 s knot and its neighbours' pieces); next to a limited
-    // slope it jumps, by at most 9.1 m/s^2 (altitude at 395 s, second-stage ignition).
+    // slope it jumps, by at most 9.0 m/s^2 (altitude at the 395 s row).
     for (int i = 1; i < 8; ++i) {
       const double k = kTable16[i][0];
       INFO("knot " << k);

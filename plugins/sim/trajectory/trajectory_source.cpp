@@ -129,7 +129,7 @@ void register_components(Registrar& r) {
           "to the 304 km row at 453 s and falls to 302 km at 540 s, never outside the rows either side (the plain "
           "spline swung 254.7 m uprange near 28 s). Velocity is continuous and the exact derivative of the position; "
           "the acceleration is the exact derivative of the velocity but jumps at knots next to a limited slope (up to "
-          "9.1 m/s2, at the 395 s row). It passes through every row, reaches about 8.1 km/s at 540 s and about 395 "
+          "9.0 m/s2, at the 395 s row). It passes through every row, reaches about 8.1 km/s at 540 s and about 395 "
           "m/s at Mach 1 (54 s). The track starts "
           "at pad_position (ENU, relative to the frame's origin, e.g. a radar ~100 km away) and runs along the "
           "compass launch_azimuth. earth: flat (default) lays downrange along a straight ground line and altitude "
