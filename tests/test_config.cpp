@@ -89,3 +89,22 @@ TEST_CASE("overrides from the command line replace or add parameters") {
   CHECK_THROWS_WITH(parse_pipeline(v, "p.yaml", {parse_override("kff.q=4")}), Catch::Contains("did you mean 'kf'"));
   CHECK_THROWS_AS(parse_override("kfq4"), ConfigError);
 }
+
+TEST_CASE("a list of checks puts several checks on one metric") {
+  const std::string head = "pipeline: {name: a}\nnodes:\n  - {id: s, type: sink.metrics}\nexpect:\n";
+  auto cfg = parse_pipeline(
+      load_yaml_string(head + "  s.position_rmse: [{ max: 5 }, { less_than: b.position_rmse }, { min: 1, max: 4 }]\n", "p.yaml"),
+      "p.yaml");
+  REQUIRE(cfg.expects.size() == 4);
+  CHECK(cfg.expects[0].op == "max");
+  CHECK(cfg.expects[0].value == 5.0);
+  CHECK(cfg.expects[1].op == "less_than");
+  CHECK(cfg.expects[1].ref_node == "b");
+  CHECK(cfg.expects[2].op == "min");
+  CHECK(cfg.expects[3].op == "max");
+  for (const auto& e : cfg.expects) CHECK(e.metric == "position_rmse");
+  CHECK_THROWS_WITH(parse_pipeline(load_yaml_string(head + "  s.anees: []\n", "p.yaml"), "p.yaml"),
+                    Catch::Contains("empty list"));
+  CHECK_THROWS_WITH(parse_pipeline(load_yaml_string(head + "  s.anees: [{ maxx: 1 }]\n", "p.yaml"), "p.yaml"),
+                    Catch::Contains("did you mean 'max'"));
+}

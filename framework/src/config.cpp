@@ -141,7 +141,7 @@ ExpectConfig parse_expect(const std::string& key, const SourceLoc& key_loc, cons
   e.node = key.substr(0, dot);
   e.metric = key.substr(dot + 1);
   if (v.kind != Value::Kind::Map || v.entries.empty())
-    throw ConfigError("expect '" + key + "' must be a map such as { max: 25 } or { within_band: 0.95 }", v.loc);
+    throw ConfigError("expect '" + key + "' must be a map such as { max: 25 } or { within_band: 0.95 }, or a list of them", v.loc);
   static const std::vector<std::string> ops = {"min",       "max",       "within_band",  "outside_band", "equals",
                                                "tolerance", "less_than", "greater_than", "ratio_to"};
   reject_unknown_keys(v, ops, "expect '" + key + "'");
@@ -303,13 +303,28 @@ PipelineConfig parse_pipeline(const Value& root, const std::string& file, const 
   if (const Value* ex = root.find("expect")) {
     if (ex->kind != Value::Kind::Map) throw ConfigError("'expect' must be a map of <node>.<metric>: {check}", ex->loc);
     for (size_t i = 0; i < ex->entries.size(); ++i) {
-      const auto& [key, val] = ex->entries[i];
-      // { min: a, max: b, less_than: x.y } is one check per comparison, each checked (tolerance goes
-      // with equals, ratio_to with min and max).
-      int comparisons = 0;
-      if (val.kind == Value::Kind::Map)
-        for (const auto& [op, unused] : val.entries) comparisons += op != "tolerance" && op != "ratio_to";
-      if (comparisons > 1) {
+      const auto& [key, entry] = ex->entries[i];
+      // A list of check maps puts several checks on one metric, e.g. an absolute bound and a
+      // comparison: [{ max: 5 }, { less_than: baseline.position_rmse }].
+      std::vector<const Value*> checks;
+      if (entry.kind == Value::Kind::List) {
+        if (entry.items.empty())
+          throw ConfigError("expect '" + key + "': an empty list of checks", entry.loc);
+        for (const Value& item : entry.items) checks.push_back(&item);
+      } else {
+        checks.push_back(&entry);
+      }
+      for (const Value* check : checks) {
+        const Value& val = *check;
+        // { min: a, max: b, less_than: x.y } is one check per comparison, each checked (tolerance
+        // goes with equals, ratio_to with min and max).
+        int comparisons = 0;
+        if (val.kind == Value::Kind::Map)
+          for (const auto& [op, unused] : val.entries) comparisons += op != "tolerance" && op != "ratio_to";
+        if (comparisons <= 1) {
+          cfg.expects.push_back(parse_expect(key, ex->key_locs[i], val));
+          continue;
+        }
         for (const auto& [op, opval] : val.entries) {
           if (op == "tolerance" || op == "ratio_to") continue;
           Value one;
@@ -324,8 +339,6 @@ PipelineConfig parse_pipeline(const Value& root, const std::string& file, const 
           }
           cfg.expects.push_back(parse_expect(key, ex->key_locs[i], one));
         }
-      } else {
-        cfg.expects.push_back(parse_expect(key, ex->key_locs[i], val));
       }
     }
   }
