@@ -116,9 +116,10 @@ TEST_CASE("sites and frame_origin are parsed and checked") {
   CHECK_THAT(err("pipeline: {name: a, frame_origin: jeu}\n" + sites + nodes),
              Catch::Contains("p.yaml:1:35: frame_origin 'jeu' is not a site (did you mean 'jeju'?); sites: naro, jeju"));
   CHECK_THAT(err("pipeline: {name: a, frame_origin: jeju}\n" + nodes), Catch::Contains("no 'sites:' section"));
-  CHECK_THAT(err("pipeline: {name: a}\nsites: [naro]\n" + nodes), Catch::Contains("'sites' must be a map"));
-  CHECK_THAT(err("pipeline: {name: a}\nsites: { naro: 34 }\n" + nodes), Catch::Contains("site 'naro' must be a map"));
-  CHECK_THAT(err("pipeline: {name: a}\nsites: { naro: { name: x, latitude: 1 } }\n" + nodes),
+  CHECK_THAT(err("pipeline: {name: a, frame_origin: naro}\nsites: [naro]\n" + nodes), Catch::Contains("'sites' must be a map"));
+  CHECK_THAT(err("pipeline: {name: a, frame_origin: naro}\nsites: { naro: 34 }\n" + nodes), Catch::Contains("site 'naro' must be a map"));
+  CHECK_THAT(err("pipeline: {name: a, frame_origin: naro}\nsites: { naro: { name: x, latitude: 1 } }\n" + nodes),
              Catch::Contains("remove 'name'"));
-  CHECK(err("pipeline: {name: a}\n" + sites + nodes) == "no error");
+  CHECK_THAT(err("pipeline: {name: a}\n" + sites + nodes), Catch::Contains("'sites' needs 'frame_origin: <site>'"));
+  CHECK(err("pipeline: {name: a, frame_origin: naro}\n" + sites + nodes) == "no error");
 }

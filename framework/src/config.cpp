@@ -301,7 +301,14 @@ PipelineConfig parse_pipeline(const Value& root, const std::string& file, const 
     throw ConfigError("missing 'pipeline:' section (name, seed, runs)", root.loc);
   }
   if (cfg.name.empty()) cfg.name = std::filesystem::path(file).stem().string();
-  if (const Value* v = root.find("sites")) cfg.sites = parse_sites(*v);
+  if (const Value* v = root.find("sites")) {
+    cfg.sites = parse_sites(*v);
+    // Sites are positions in the ENU frame only once the frame is anchored at one of them.
+    if (!cfg.frame_origin.is_scalar())
+      throw ConfigError("'sites' needs 'frame_origin: <site>' in the pipeline: section (the site the ENU frame is "
+                        "anchored at)",
+                        v->loc);
+  }
   if (cfg.frame_origin.is_scalar()) {
     std::vector<std::string> names;
     for (const auto& site : cfg.sites.items) names.push_back(site.entries.front().second.scalar);

@@ -53,7 +53,7 @@ Run convert(const std::string& yaml, const std::vector<Measurement>& in) {
 // measured: theta_c = theta_m - b(theta_m) (paper 004's baseline); solved: theta_c + b(theta_c) =
 // theta_m to rounding. Range and azimuth pass unchanged; the elevation's variance and covariances
 // scale with d theta_c / d theta_m.
-TEST_CASE("clark correction at the measured and the solved elevation") {
+TEST_CASE("correction at measured and solved elevation") {
   sim::ClarkModel clark;
   for (double el : {2.5, 5.0, 9.0, 30.0}) {
     INFO("elevation " << el << " deg");

@@ -115,7 +115,7 @@ TEST_CASE("bias estimate follows a matched clark bias") {
 }
 
 // Without the bias state the filter tracks the apparent elevation: its error is Clark's b.
-TEST_CASE("without the bias state the bias stays in the elevation") {
+TEST_CASE("no bias state leaves b in the elevation") {
   const auto ms = descending_pass(3);
   const Outcome o = filter("sigma_accel: 20 m/s2\nbias_state: false", ms);
   sim::ClarkModel clark;
@@ -129,7 +129,7 @@ TEST_CASE("without the bias state the bias stays in the elevation") {
 // and converge; normalisation without scaling (K / ||K|| dominated by the metre-per-radian rows)
 // leaves the radar states without gain: every estimate is still finite, and the summary says the
 // run did not converge.
-TEST_CASE("normalisation and scaling switched off still run finite") {
+TEST_CASE("normalisation and scaling off run finite") {
   const auto ms = descending_pass(5);
   struct Case {
     const char* yaml;

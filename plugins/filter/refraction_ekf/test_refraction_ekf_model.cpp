@@ -75,7 +75,7 @@ TEST_CASE("jacobian matches a numerical jacobian") {
 }
 
 // The rates are the time derivatives of range, azimuth and elevation of a moving target.
-TEST_CASE("radar-state rates are derivatives of the geometry") {
+TEST_CASE("radar-state rates are geometry derivatives") {
   for (auto conv : {AzimuthConvention::NorthClockwise, AzimuthConvention::XCounterClockwise}) {
     const double sign = conv == AzimuthConvention::NorthClockwise ? -1.0 : 1.0;
     const Vec3 p(-3e5, 8e5, 9e4), v(2000.0, -5000.0, 700.0);

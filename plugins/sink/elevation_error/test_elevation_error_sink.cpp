@@ -73,7 +73,7 @@ const std::vector<InputInfo> kEkf = {{"ekf", "filter.refraction_ekf", mask(ItemK
 // Measurements 0.01 deg high, except 0.05 deg at t = 70 s in run 1: with below 10 deg and from 30
 // s, samples t = 30..100 (el 9 -> 2 deg) are scored; max 0.05 deg, RMS over both runs, the mean of
 // each run's max 0.03 deg. t < 20 s (el > 10 deg) would carry 1 deg and must not count.
-TEST_CASE("elevation error in degrees over a band, per run and ensemble") {
+TEST_CASE("errors in degrees per run and ensemble") {
   const Summary s = score("{below: 10 deg, from_time: 30 s}", kRadar, 2, [](Component& c, int run) {
     for (int k = 0; k <= 100; ++k) {
       const double t = k;
