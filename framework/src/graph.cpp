@@ -180,10 +180,12 @@ std::string frames(FrameMask m) {
   return f.empty() ? "no" : join(f, "/");
 }
 
+// The converters that turn measurements into Cartesian ones (not, e.g., a spherical corrector).
 std::vector<std::string> converter_types(const PluginRegistry& registry) {
   std::vector<std::string> out;
   for (const auto& t : registry.types())
-    if (t.decl.kind == ComponentKind::Converter) out.push_back(t.decl.type);
+    if (t.decl.kind == ComponentKind::Converter && (t.decl.produces_frames & mask(Frame::Cartesian)))
+      out.push_back(t.decl.type);
   std::sort(out.begin(), out.end());
   return out;
 }
