@@ -7,7 +7,7 @@ mode=${1:-run}
 BUILD=${TRACKFLOW_BUILD_DIR:-build}
 
 packages=(g++ cmake ninja-build ccache pkg-config libeigen3-dev libboost-dev libboost-program-options-dev
-          libyaml-cpp-dev catch2 nlohmann-json3-dev)
+          libyaml-cpp-dev catch2 nlohmann-json3-dev libgeographiclib-dev)
 # Test only: the headless-browser test of the report (tests/report/browser.sh) and a font for its screenshot.
 if [ "$mode" = test ]; then packages+=(chromium fonts-dejavu-core); fi
 missing=()

@@ -108,3 +108,37 @@ TEST_CASE("a list of checks puts several checks on one metric") {
   CHECK_THROWS_WITH(parse_pipeline(load_yaml_string(head + "  s.anees: [{ maxx: 1 }]\n", "p.yaml"), "p.yaml"),
                     Catch::Contains("did you mean 'max'"));
 }
+
+// The top-level sites: map becomes a list of records with the site's name first, located where
+// the analyst wrote them; pipeline.frame_origin must name one of them.
+TEST_CASE("sites and frame_origin are parsed and checked") {
+  const std::string nodes = "nodes:\n  - {id: a, type: x}\n";
+  const std::string sites =
+      "sites:\n  naro: { latitude: 34.43 deg, longitude: 127.53 deg }\n  jeju: { latitude: 33.28 deg, longitude: "
+      "126.46 deg, height: 100 m }\n";
+  auto cfg = parse_pipeline(load_yaml_string("pipeline: {name: a, frame_origin: jeju}\n" + sites + nodes, "p.yaml"),
+                            "p.yaml");
+  REQUIRE(cfg.sites.items.size() == 2);
+  CHECK(cfg.sites.items[1].entries.front().first == "name");
+  CHECK(cfg.sites.items[1].entries.front().second.scalar == "jeju");
+  CHECK(cfg.sites.items[1].find("height")->scalar == "100 m");
+  CHECK(cfg.sites.items[1].find("height")->loc.line == 4);
+  CHECK(cfg.frame_origin.scalar == "jeju");
+  auto err = [&](const std::string& yaml) -> std::string {
+    try {
+      parse_pipeline(load_yaml_string(yaml, "p.yaml"), "p.yaml");
+    } catch (const ConfigError& e) {
+      return e.message();
+    }
+    return "no error";
+  };
+  CHECK_THAT(err("pipeline: {name: a, frame_origin: jeu}\n" + sites + nodes),
+             Catch::Contains("p.yaml:1:35: frame_origin 'jeu' is not a site (did you mean 'jeju'?); sites: naro, jeju"));
+  CHECK_THAT(err("pipeline: {name: a, frame_origin: jeju}\n" + nodes), Catch::Contains("no 'sites:' section"));
+  CHECK_THAT(err("pipeline: {name: a, frame_origin: naro}\nsites: [naro]\n" + nodes), Catch::Contains("'sites' must be a map"));
+  CHECK_THAT(err("pipeline: {name: a, frame_origin: naro}\nsites: { naro: 34 }\n" + nodes), Catch::Contains("site 'naro' must be a map"));
+  CHECK_THAT(err("pipeline: {name: a, frame_origin: naro}\nsites: { naro: { name: x, latitude: 1 } }\n" + nodes),
+             Catch::Contains("remove 'name'"));
+  CHECK_THAT(err("pipeline: {name: a}\n" + sites + nodes), Catch::Contains("'sites' needs 'frame_origin: <site>'"));
+  CHECK(err("pipeline: {name: a, frame_origin: naro}\n" + sites + nodes) == "no error");
+}

@@ -183,6 +183,36 @@ ExpectConfig parse_expect(const std::string& key, const SourceLoc& key_loc, cons
   return e;
 }
 
+// `sites: { name: { latitude: .., longitude: .., height: .. }, ... }` -> a list of records, each
+// with its `name` first (a Records parameter's shape); the fields are validated by the components
+// that declare `sites`, against their own field declarations.
+Value parse_sites(const Value& v) {
+  if (v.kind != Value::Kind::Map || v.entries.empty())
+    throw ConfigError("'sites' must be a map of name: { latitude, longitude, height }", v.loc);
+  Value list;
+  list.kind = Value::Kind::List;
+  list.loc = v.loc;
+  for (size_t i = 0; i < v.entries.size(); ++i) {
+    const auto& [name, site] = v.entries[i];
+    if (name.empty() || name.find_first_of(". =") != std::string::npos)
+      throw ConfigError("site name '" + name + "' must be non-empty and contain no '.', '=' or space", v.key_locs[i]);
+    if (site.kind != Value::Kind::Map)
+      throw ConfigError("site '" + name + "' must be a map such as { latitude: 34.43 deg, longitude: 127.53 deg, "
+                        "height: 0 m }, got " + site.describe(), site.loc);
+    if (site.find("name"))
+      throw ConfigError("site '" + name + "': the key is its name; remove 'name'", site.key_loc("name"));
+    Value record = site;
+    Value n;
+    n.kind = Value::Kind::Scalar;
+    n.scalar = name;
+    n.loc = v.key_locs[i];
+    record.entries.insert(record.entries.begin(), {"name", n});
+    record.key_locs.insert(record.key_locs.begin(), v.key_locs[i]);
+    list.items.push_back(std::move(record));
+  }
+  return list;
+}
+
 }  // namespace
 
 const Value* Value::find(const std::string& key) const {
@@ -233,7 +263,7 @@ PipelineConfig parse_pipeline(const Value& root, const std::string& file, const 
   cfg.file = file;
   if (root.kind != Value::Kind::Map)
     throw ConfigError("a pipeline file is a map with 'pipeline', 'nodes' and optionally 'expect'", root.loc);
-  reject_unknown_keys(root, {"pipeline", "nodes", "expect", "plugin_paths"}, "the top level");
+  reject_unknown_keys(root, {"pipeline", "sites", "nodes", "expect", "plugin_paths"}, "the top level");
   const std::filesystem::path base = std::filesystem::path(file).parent_path();
   auto add_paths = [&](const Value& v) {
     for (const auto& p : string_list(v, "plugin_paths")) {
@@ -243,8 +273,9 @@ PipelineConfig parse_pipeline(const Value& root, const std::string& file, const 
   };
   if (const Value* p = root.find("pipeline")) {
     if (p->kind != Value::Kind::Map) throw ConfigError("'pipeline' must be a map", p->loc);
-    reject_unknown_keys(*p, {"name", "description", "seed", "runs", "on_bad_row", "plugin_paths", "file_format"},
-                        "'pipeline'");
+    reject_unknown_keys(
+        *p, {"name", "description", "seed", "runs", "on_bad_row", "plugin_paths", "file_format", "frame_origin"},
+        "'pipeline'");
     if (const Value* v = p->find("name")) cfg.name = scalar(*v, "name");
     if (const Value* v = p->find("description")) cfg.description = scalar(*v, "description");
     if (const Value* v = p->find("seed")) cfg.seed = to_count(*v, "seed");
@@ -258,6 +289,10 @@ PipelineConfig parse_pipeline(const Value& root, const std::string& file, const 
         throw ConfigError("on_bad_row must be 'error' or 'skip', got '" + cfg.on_bad_row + "'", v->loc);
     }
     if (const Value* v = p->find("plugin_paths")) add_paths(*v);
+    if (const Value* v = p->find("frame_origin")) {
+      scalar(*v, "frame_origin");
+      cfg.frame_origin = *v;
+    }
     if (const Value* v = p->find("file_format")) {
       if (scalar(*v, "file_format") != "1")
         throw ConfigError("file_format " + v->scalar + " is not supported by this trackflow (supports 1)", v->loc);
@@ -266,6 +301,26 @@ PipelineConfig parse_pipeline(const Value& root, const std::string& file, const 
     throw ConfigError("missing 'pipeline:' section (name, seed, runs)", root.loc);
   }
   if (cfg.name.empty()) cfg.name = std::filesystem::path(file).stem().string();
+  if (const Value* v = root.find("sites")) {
+    cfg.sites = parse_sites(*v);
+    // Sites are positions in the ENU frame only once the frame is anchored at one of them.
+    if (!cfg.frame_origin.is_scalar())
+      throw ConfigError("'sites' needs 'frame_origin: <site>' in the pipeline: section (the site the ENU frame is "
+                        "anchored at)",
+                        v->loc);
+  }
+  if (cfg.frame_origin.is_scalar()) {
+    std::vector<std::string> names;
+    for (const auto& site : cfg.sites.items) names.push_back(site.entries.front().second.scalar);
+    if (names.empty())
+      throw ConfigError("frame_origin '" + cfg.frame_origin.scalar +
+                            "' names a site, but the pipeline has no 'sites:' section",
+                        cfg.frame_origin.loc);
+    if (std::find(names.begin(), names.end(), cfg.frame_origin.scalar) == names.end())
+      throw ConfigError("frame_origin '" + cfg.frame_origin.scalar + "' is not a site" +
+                            did_you_mean(cfg.frame_origin.scalar, names) + "; sites: " + join(names),
+                        cfg.frame_origin.loc);
+  }
   if (const Value* v = root.find("plugin_paths")) add_paths(*v);
 
   const Value* nodes = root.find("nodes");

@@ -35,25 +35,35 @@ Graph build_graph(PipelineConfig cfg, const PluginRegistry& registry) {
     index[g.config.nodes[i].id] = static_cast<int>(i);
     ids.push_back(g.config.nodes[i].id);
   }
+  bool sites_used = false;
   for (const auto& nc : g.config.nodes) {
     GraphNode n;
     n.config = nc;
     n.type = registry.find(nc.type);
     if (!n.type) throw ConfigError(unknown_type_message(nc.type, registry), nc.type_loc, nc.id);
     const ComponentDecl& d = n.type->decl;
-    // A pipeline-wide on_bad_row applies to every node that declares the parameter.
+    // Pipeline-wide settings (on_bad_row, sites, frame_origin) apply to every node that declares the
+    // parameter and does not set it itself.
     Value params = nc.params;
-    const bool declares_bad_row =
-        std::any_of(d.params.begin(), d.params.end(), [](const ParamSpec& s) { return s.name == "on_bad_row"; });
-    if (declares_bad_row && !params.find("on_bad_row")) {
+    auto declares = [&](const char* name) {
+      return std::any_of(d.params.begin(), d.params.end(), [&](const ParamSpec& s) { return s.name == name; });
+    };
+    auto inject = [&](const char* name, const Value& v, const SourceLoc& key_loc) {
+      if (!declares(name) || params.find(name)) return;
       if (params.kind != Value::Kind::Map) params.kind = Value::Kind::Map;
-      Value v;
-      v.kind = Value::Kind::Scalar;
-      v.scalar = g.config.on_bad_row;
-      v.loc = params.loc;
-      params.entries.emplace_back("on_bad_row", v);
-      params.key_locs.push_back(params.loc);
+      params.entries.emplace_back(name, v);
+      params.key_locs.push_back(key_loc);
+    };
+    Value bad_row;
+    bad_row.kind = Value::Kind::Scalar;
+    bad_row.scalar = g.config.on_bad_row;
+    bad_row.loc = params.loc;
+    inject("on_bad_row", bad_row, params.loc);
+    if (g.config.sites.kind == Value::Kind::List) {
+      sites_used |= declares("sites");
+      inject("sites", g.config.sites, g.config.sites.loc);
     }
+    if (g.config.frame_origin.is_scalar()) inject("frame_origin", g.config.frame_origin, g.config.frame_origin.loc);
     n.params = validate_params(d.params, params, nc.id, nc.loc);
     for (size_t k = 0; k < nc.inputs.size(); ++k) {
       const auto& in = nc.inputs[k];
@@ -83,6 +93,11 @@ Graph build_graph(PipelineConfig cfg, const PluginRegistry& registry) {
     }
     g.nodes.push_back(std::move(n));
   }
+
+  if (g.config.sites.kind == Value::Kind::List && !sites_used)
+    throw ConfigError("'sites' is given but no node takes sites (e.g. sim.trajectory with earth: wgs84, sim.radar "
+                      "with a site); remove it",
+                      g.config.sites.loc);
 
   // Wiring: each input must deliver something this node accepts.
   for (auto& n : g.nodes) {
@@ -165,10 +180,12 @@ std::string frames(FrameMask m) {
   return f.empty() ? "no" : join(f, "/");
 }
 
+// The converters that turn measurements into Cartesian ones (not, e.g., a spherical corrector).
 std::vector<std::string> converter_types(const PluginRegistry& registry) {
   std::vector<std::string> out;
   for (const auto& t : registry.types())
-    if (t.decl.kind == ComponentKind::Converter) out.push_back(t.decl.type);
+    if (t.decl.kind == ComponentKind::Converter && (t.decl.produces_frames & mask(Frame::Cartesian)))
+      out.push_back(t.decl.type);
   std::sort(out.begin(), out.end());
   return out;
 }

@@ -1,5 +1,6 @@
 // Purpose: sim.trajectory — a truth generator that flies CV / CA / turn / velocity-change segments or a launch profile exactly, optionally with white-noise acceleration or jerk.
 #include "flight_plan.hpp"
+#include "geodetic_launch.hpp"
 #include "launch_profile.hpp"
 #include "process_noise.hpp"
 
@@ -18,10 +19,20 @@ using sim::MotionPiece;
 // this close to a velocity change counts as at it (and the last sample as at the end).
 constexpr double kTimeTolerance = 1e-9;  // s
 
+// Segments, or the profile on a flat, spherical or WGS-84 earth. pad_site belongs to the last only.
+std::vector<MotionPiece> build_pieces(const Params& params) {
+  const bool wgs84 = params.choice<sim::Earth>("earth") == sim::Earth::Wgs84;
+  if (params.given("pad_site") && !(wgs84 && params.choice<sim::Profile>("profile") != sim::Profile::None))
+    throw params.error("pad_site", "applies to a launch profile on 'earth: wgs84' only (flat and spherical earths take "
+                                   "pad_position)");
+  if (params.choice<sim::Profile>("profile") == sim::Profile::None) return sim::build_flight_plan(params);
+  return wgs84 ? sim::build_geodetic_launch_plan(params) : sim::build_launch_plan(params);
+}
+
 class TrajectorySource final : public Generator {
  public:
   explicit TrajectorySource(const Params& params)
-      : pieces_(params.choice<sim::Profile>("profile") == sim::Profile::None ? sim::build_flight_plan(params) : sim::build_launch_plan(params)),
+      : pieces_(build_pieces(params)),
         rate_(params.real("rate")),
         start_(params.real("start_time")),
         noise_(sim::process_noise_q(params), 1.0 / rate_),
@@ -137,7 +148,12 @@ void register_components(Registrar& r) {
           "it ignores the earth's curvature, which at 2054 km downrange puts the real vehicle about 340 km lower "
           "(below a pad radar's horizon). earth: spherical bends the track over a sphere of radius 6371 km whose "
           "surface passes through the frame's origin: downrange is the great-circle arc, altitude is measured from "
-          "the pad's radius, and the azimuth is the frame's compass direction carried to the pad.\n"
+          "the pad's radius, and the azimuth is the frame's compass direction carried to the pad. earth: wgs84 flies the "
+          "profile over the WGS-84 ellipsoid (GeographicLib): the pad is pad_site, one of the pipeline's geodetic "
+          "sites: (latitude, longitude, height), the ENU frame is anchored at pipeline.frame_origin; downrange is the "
+          "distance along the geodesic leaving the pad at the compass launch_azimuth, altitude (above lift-off) is added "
+          "to the pad's height along the ellipsoid normal; velocity and acceleration follow by the chain rule with "
+          "central differences of the geodesic over 100 m of downrange (see docs/papers/004-refraction-bias.md).\n"
           "Process noise (off by default): process_noise_q > 0 (or process_noise_q_enu, one value per ENU axis) adds to "
           "any of the above a deviation driven by continuous white acceleration of that spectral density, the continuous "
           "white noise acceleration (CV) model of Bar-Shalom, Li & Kirubarajan 2001 §6.2.2 (eq 6.2.2-12), discretised "
@@ -171,9 +187,14 @@ void register_components(Registrar& r) {
           .def("none"),
       ParamSpec::real_list("pad_position", dim::length, "profile: launch pad position in the ENU frame", 3),
       ParamSpec::real("launch_azimuth", dim::angle, "profile: compass direction of the downrange track, from north clockwise"),
-      ParamSpec::choice<sim::Earth>("earth", {{sim::Earth::Flat, "flat"}, {sim::Earth::Spherical, "spherical"}},
-                               "profile: flat ground line (paper 000) or a spherical earth")
+      ParamSpec::choice<sim::Earth>("earth",
+                                    {{sim::Earth::Flat, "flat"}, {sim::Earth::Spherical, "spherical"}, {sim::Earth::Wgs84, "wgs84"}},
+                                    "profile: flat ground line (paper 000), a spherical earth, or the WGS-84 ellipsoid "
+                                    "from a geodetic pad_site")
           .def("flat"),
+      ParamSpec::string("pad_site", "profile on earth: wgs84: the launch pad, a site of the pipeline's sites: map"),
+      sim::sites_param(),
+      sim::frame_origin_param(),
       ParamSpec::real("profile_duration", dim::time, "profile: fly only the first part of it (default: the whole table)").positive(),
       ParamSpec::real("process_noise_q", dim::accel_psd,
                       "spectral density of white acceleration added to the truth, every ENU axis (0: off)")

@@ -66,6 +66,12 @@ struct PipelineConfig {
   std::vector<std::string> plugin_paths;  // resolved relative to the file
   std::vector<NodeConfig> nodes;
   std::vector<ExpectConfig> expects;
+  // Top-level `sites:` (name -> {latitude, longitude, height}) as a list of records, each with its
+  // `name`; given to every node that declares a `sites` parameter (and does not set its own).
+  Value sites;
+  // `pipeline.frame_origin`: the site the pipeline's ENU frame is anchored at; given to every
+  // node that declares a `frame_origin` parameter. Empty: none.
+  Value frame_origin;
 };
 
 // A `--set node.param=value` override, applied to the tree before validation.
