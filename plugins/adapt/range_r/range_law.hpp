@@ -15,8 +15,8 @@ struct RangeLaw {
   double thermal_exponent = 4.0, glint_exponent = 2.0;
   double min_range = 1.0;          // m: closer ranges are evaluated here (the glint part diverges at 0)
 
-  double thermal(double r) const { return alpha * std::pow(clamp(r) / reference_range, thermal_exponent); }
-  double glint(double r) const { return beta * std::pow(reference_range / clamp(r), glint_exponent); }
+  double thermal(double r) const { return alpha * power(clamp(r) / reference_range, thermal_exponent); }
+  double glint(double r) const { return beta * power(reference_range / clamp(r), glint_exponent); }
   double variance(double r) const { return thermal(r) + glint(r); }
   // Where R is smallest: dR/dr = 0 at r0 (b beta / (a alpha))^(1 / (a + b)).
   double minimum_range() const {
@@ -25,6 +25,13 @@ struct RangeLaw {
 
  private:
   double clamp(double r) const { return std::max(r, min_range); }
+  // x^e; whole exponents (the usual 4 and 2) by multiplication, which is exact and cheap per update.
+  static double power(double x, double e) {
+    if (e == 2.0) return x * x;
+    if (e == 4.0) return (x * x) * (x * x);
+    if (e == 0.0) return 1.0;
+    return std::pow(x, e);
+  }
 };
 
 }  // namespace trackflow::adapt

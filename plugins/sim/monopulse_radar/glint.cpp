@@ -19,10 +19,6 @@ GlintProcess::GlintProcess(GlintSettings s) : s_(s) {
   axis_scale_ = s_.per_plane ? std::sqrt(2.0) : 1.0;
 }
 
-void GlintProcess::advance(double dt, double fade_uniform, Rng& rng) {
-  if (dar1_renew(lorentzian_correlation(s_.bandwidth, dt), rng)) renew(fade_uniform, rng);
-}
-
 void GlintProcess::renew(double fade_uniform, Rng& rng) {
   laplacian_ = rng.uniform() < s_.laplace_weight;
   const double own = rng.uniform();

@@ -11,7 +11,7 @@ struct GlintSettings {
   double sigma = 9.5;            // RMS of the linear glint, m (Table 1: 0.2 L for a rectangle of length L)
   double laplace_weight = 0.5;   // i of eq 3-9
   double variance_ratio = 100;   // Laplacian variance / Gaussian variance (the paper: 178.7 / 1.787)
-  double bandwidth = 1.0;        // B of eq 3-10, Hz
+  double bandwidth = 1.0;        // B of eq 3-10, Hz (the plugin's default is 10 Hz; tests use 1 Hz)
   // true: sigma is the RMS in each plane (Table 1's sigma = R/sqrt(2) is the scintillation in one
   // plane), so the rotated glint has RMS sqrt(2) sigma and each axis sigma; false: the rotated glint
   // itself has RMS sigma and each axis sigma/sqrt(2) (Fig 18 taken literally).
@@ -39,7 +39,20 @@ class GlintProcess {
   void start(double fade_uniform, Rng& rng) { renew(fade_uniform, rng); }
   // A later look dt after the previous one: DAR(1), the value holds with probability
   // exp(-2 pi B dt), so the glint's autocorrelation is exactly exp(-2 pi B tau) (eq 3-10).
-  void advance(double dt, double fade_uniform, Rng& rng);
+  // `fade_uniform()` is only evaluated when the glint renews. Returns true when it did.
+  template <class FadeUniform>
+  bool advance(double dt, FadeUniform&& fade_uniform, Rng& rng) {
+    if (dt != last_dt_) {  // fixed-rate looks: the exponential once
+      rho_ = lorentzian_correlation(s_.bandwidth, dt);
+      last_dt_ = dt;
+    }
+    if (!dar1_renew(rho_, rng)) return false;
+    renew(fade_uniform(), rng);
+    return true;
+  }
+  bool advance(double dt, double fade_uniform, Rng& rng) {
+    return advance(dt, [fade_uniform] { return fade_uniform; }, rng);
+  }
 
   double linear() const { return g_; }        // m, along the rotated direction
   double azimuth_m() const { return az_; }    // m, azimuth-plane component (eq 3-11 divides by range)
@@ -53,6 +66,7 @@ class GlintProcess {
   GlintSettings s_;
   double sd_gauss_ = 0.0, sd_laplace_ = 0.0, axis_scale_ = 1.0;
   double g_ = 0.0, az_ = 0.0, el_ = 0.0;
+  double last_dt_ = -1.0, rho_ = 0.0;
   bool laplacian_ = false;
 };
 

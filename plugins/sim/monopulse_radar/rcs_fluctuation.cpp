@@ -14,7 +14,7 @@ double rcs_cdf(double x, int components) {
 }
 
 void RcsFluctuation::start(double t, Rng& rng) {
-  for (auto& g : g_) g.start(rng);
+  for (int i = 0; i < components(); ++i) g_[i].start(rng);
   last_time_ = t;
   scan_start_ = t;
   scan_ = 0;
@@ -29,8 +29,12 @@ void RcsFluctuation::advance(double t, Rng& rng) {
     scan_ = scan;
     evaluate_at = scan_start_ + static_cast<double>(scan) * scan_period_;
   }
-  const double rho = lorentzian_correlation(bandwidth_, evaluate_at - last_time_);
-  for (auto& g : g_) g.advance(rho, rng);
+  const double dt = evaluate_at - last_time_;
+  if (dt != last_dt_) {  // fixed-rate looks: the exponential once
+    rho_ = lorentzian_correlation(bandwidth_, dt);
+    last_dt_ = dt;
+  }
+  for (int i = 0; i < components(); ++i) g_[i].advance(rho_, rng);
   last_time_ = evaluate_at;
   update_factor();
 }

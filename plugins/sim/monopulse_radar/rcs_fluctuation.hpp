@@ -24,8 +24,8 @@ class RcsFluctuation {
   RcsFluctuation(SwerlingCase c, double bandwidth, double scan_period)
       : case_(c), bandwidth_(bandwidth), scan_period_(scan_period) {}
 
-  // First look of a run at time t: a stationary draw. Draws 4 normals whatever the case, so the
-  // stream does not depend on it.
+  // First look of a run at time t: a stationary draw (one normal per component; the RCS has its own
+  // random stream, so the case changes no other effect's draws).
   void start(double t, Rng& rng);
   // Look at time t >= the previous one.
   void advance(double t, Rng& rng);
@@ -47,6 +47,7 @@ class RcsFluctuation {
   GaussMarkov g_[4];
   double x_ = 1.0;
   double last_time_ = 0.0;  // time of the last evaluation of the g's
+  double last_dt_ = -1.0, rho_ = 0.0;
   double scan_start_ = 0.0;
   long long scan_ = 0;
 };

@@ -1,5 +1,6 @@
 // Purpose: tests of sim.monopulse_radar through the plugin: each effect alone against its closed form, misses, stream independence, determinism, refused parameters.
 #include "monopulse_antenna.hpp"
+#include "process_statistics.hpp"
 #include "radar_equation.hpp"
 
 #include <trackflow/error.hpp>
@@ -171,4 +172,35 @@ TEST_CASE("parameters of an effect that is off are refused") {
   CHECK_THROWS_AS(test::make("sim.monopulse_radar", "{ thermal: false, wavelength: 3 cm }"), ConfigError);
   CHECK_THROWS_AS(test::make("sim.monopulse_radar", "{ antenna: linear, squint: 0.4 }"), ConfigError);
   CHECK_NOTHROW(test::make("sim.monopulse_radar", "{ rcs_model: swerling3, rcs_scan_period: 2 s }"));
+}
+
+// The summary's estimators on a hand-made series: variance about zero for the glint, lag-1 coefficients
+// as written in process_statistics.hpp, computed here directly.
+TEST_CASE("process statistics estimators") {
+  sim::ProcessStatistics s;
+  const double g[] = {1.0, -2.0, 0.5, 3.0}, x[] = {0.5, 1.5, 2.0, 0.2};
+  for (int k = 0; k < 4; ++k) {
+    ++s.looks;
+    ++s.glint_n;
+    s.g2 += g[k] * g[k];
+    s.x += x[k];
+    s.x2 += x[k] * x[k];
+    if (k > 0) {
+      ++s.pairs;
+      s.time_steps += 0.05;
+      s.g_lag += g[k] * g[k - 1];
+      s.g_prev2 += g[k - 1] * g[k - 1];
+      s.x_lag += x[k] * x[k - 1];
+      s.x_prev += x[k - 1];
+      s.x_cur_paired += x[k];
+    }
+  }
+  CHECK(s.glint_variance() == Approx((1 + 4 + 0.25 + 9) / 4.0));
+  CHECK(s.glint_lag1() == Approx((-2 - 1 + 1.5) / (1 + 4 + 0.25)));
+  const double m = 4.2 / 4, var = (0.25 + 2.25 + 4 + 0.04) / 4 - m * m;
+  CHECK(s.rcs_variance() == Approx(var));
+  const double cov = ((0.5 - m) * (1.5 - m) + (1.5 - m) * (2.0 - m) + (2.0 - m) * (0.2 - m)) / 3;
+  CHECK(s.rcs_lag1() == Approx(cov / var));
+  CHECK(s.mean_step() == Approx(0.05));
+  CHECK(sim::ProcessStatistics::correlation_time(std::exp(-1.0), 0.05) == Approx(0.05));
 }
