@@ -23,7 +23,7 @@ TEST_CASE("lorentzian correlation is exp of minus 2 pi B dt") {
 // 200 000 samples at 20 Hz, B = 1 Hz (rho = 0.7304): unit variance and autocorrelation rho^k at lags 1, 3,
 // 10. Bounds: 5 batch-means standard errors (50 batches of 4000 samples, 640 correlation times each)
 // plus the estimator's O(1/n) bias, 3/n.
-TEST_CASE("gauss markov has unit variance and rho^k correlation") {
+TEST_CASE("gauss markov variance 1 and rho^k lags") {
   Rng rng(7);
   const double dt = 0.05, B = 1.0, rho = lorentzian_correlation(B, dt);
   GaussMarkov g;
