@@ -3,7 +3,8 @@
 # Usage: bench/paper003_study.sh [TRACKFLOW] [REPEATS]
 #   TRACKFLOW  the CLI (default build/bin/trackflow); REPEATS timed repetitions of the full study (default 3)
 # Needs GNU time (Debian package `time`). Prints the machine, the load average around each run, the wall
-# time of each repetition (the aim: <= 20 s), and max RSS for 250, 1000 and 2500 runs (the aim: flat).
+# time and CPU seconds of each repetition (the aim: <= 20 s wall), and max RSS for 250, 1000 and 2500 runs
+# (the aim: flat).
 set -eu
 cd "$(dirname "$0")/.."
 TF=${1:-build/bin/trackflow}
@@ -25,10 +26,13 @@ run() {
     cat "$OUT/time" >&2
     exit 1
   }
-  local wall rss
+  local wall rss cpu
   wall=$(awk -F': ' '/Elapsed \(wall clock\)/ { print $2 }' "$OUT/time")
   rss=$(awk -F': ' '/Maximum resident set size/ { print $2 }' "$OUT/time")
-  printf '%-22s wall %8s   max RSS %7s kB   load before %s\n' "$label" "$wall" "$rss" "$load"
+  # CPU seconds (user + system): on a shared box the wall time depends on the other jobs; CPU / 2 is
+  # what the run takes when it has both cores.
+  cpu=$(awk -F': ' '/User time/ { u = $2 } /System time/ { s = $2 } END { printf "%.1f", u + s }' "$OUT/time")
+  printf '%-16s wall %8s   CPU %6s s   max RSS %7s kB   load before %s\n' "$label" "$wall" "$cpu" "$rss" "$load"
 }
 
 for i in $(seq "$REPEATS"); do run "2500 runs (#$i)"; done
