@@ -98,12 +98,14 @@ TEST_CASE("wgs84 launch keeps geodesic downrange and height") {
 }
 
 // Velocity and acceleration are the time derivatives of the position (central differences of
-// the path itself, 1 ms apart; the tolerance is their truncation and rounding error).
+// the path itself, 10 ms apart; the tolerance is their truncation and rounding error). The times
+// lie between the profile table's rows: its monotone interpolation is C1, so the acceleration may
+// step at a row and a central difference across one measures the step, not the derivative.
 TEST_CASE("wgs84 launch velocity and acceleration are derivatives") {
   const sim::EnuFrame frame(kJeju);
   const sim::GeodeticLaunchPath path(sim::kslv1_table(), kNaro, 170 * kDeg, frame);
   const double h = 1e-2;
-  for (double t : {10.0, 54.0, 120.0, 230.5, 300.0, 420.0, 500.0, 539.0}) {
+  for (double t : {10.0, 54.5, 120.0, 230.5, 300.0, 420.0, 500.0, 539.0}) {
     INFO("t = " << t);
     const auto k = path.at(t), kp = path.at(t + h), km = path.at(t - h);
     const Vec3 v = (kp.position - km.position) / (2 * h);
