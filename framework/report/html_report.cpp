@@ -587,9 +587,10 @@ void write_text_file(const std::string& path, const std::string& text) {
   std::error_code ec;
   if (!parent.empty()) std::filesystem::create_directories(parent, ec);
   std::ofstream f(path, std::ios::binary | std::ios::trunc);
-  f << text;
-  f.flush();
   if (!f) throw ConfigError("cannot write '" + path + "': " + std::strerror(errno));
+  f << text;
+  f.close();  // a full disk shows at the flush
+  if (f.fail()) throw ConfigError("cannot write '" + path + "': " + std::strerror(errno));
 }
 
 }  // namespace trackflow::report
