@@ -259,7 +259,12 @@ Outcome run_graph(const Graph& g, const PluginRegistry& registry, const RunOptio
     std::vector<std::thread> pool;
     Joiner joiner{pool};
     try {
-      for (unsigned t = 0; t < threads; ++t) pool.emplace_back(worker);
+      // One thread and nothing to show: the calling thread does the work (a sweep runs many
+      // ensembles side by side; a thread each is enough).
+      if (threads == 1 && !opt.progress)
+        worker();
+      else
+        for (unsigned t = 0; t < threads; ++t) pool.emplace_back(worker);
     } catch (const std::system_error& e) {
       // A per-user process limit: go on with the workers that started (results do not depend
       // on their number), or on this thread if none did.

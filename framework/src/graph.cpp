@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <functional>
 #include <map>
+#include <new>
 #include <queue>
 
 namespace trackflow::host {
@@ -250,6 +251,8 @@ GraphInstance instantiate(const Graph& g, const PluginRegistry& registry) {
     throw;
   } catch (const InternalError&) {
     throw;
+  } catch (const std::bad_alloc&) {
+    throw;
   } catch (const std::exception& e) {
     throw InternalError(std::string("a plugin threw while the graph was wired: ") + e.what() + " (a bug in that plugin)");
   } catch (...) {
@@ -274,6 +277,8 @@ GraphInstance instantiate_checked(const Graph& g, const PluginRegistry& registry
       throw ConfigError(e.what(), e.where().line ? e.where() : n.config.loc, n.config.id);
     } catch (const DataError& e) {
       throw ConfigError(e.what(), n.config.loc, n.config.id);
+    } catch (const std::bad_alloc&) {
+      throw;  // out of memory is no mistake in the pipeline
     } catch (const std::exception& e) {
       // What a factory throws is most often a refusal of its parameters; it is reported with the node.
       throw ConfigError(e.what(), n.config.loc, n.config.id);

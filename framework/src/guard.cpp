@@ -9,6 +9,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <memory>
+#include <new>
 #include <typeinfo>
 
 namespace trackflow::detail {
@@ -138,6 +139,8 @@ void rethrow_from_plugin() {
     // Bad input data: exit 2, with the run and the node that found it.
     throw DataError(run + (node ? *node + ": " : std::string()) + e.what());
   } catch (const InternalError&) {
+    throw;
+  } catch (const std::bad_alloc&) {
     throw;
   } catch (const std::exception& e) {
     throw InternalError((where.empty() ? std::string("plugin code") : where) + " threw " + demangled(typeid(e).name()) +

@@ -58,9 +58,25 @@ std::string quote_token(std::string_view word, std::size_t max) {
   std::string s;
   const std::size_t n = std::min(word.size(), max);
   s.reserve(n + 3);
-  for (std::size_t i = 0; i < n; ++i) {
+  for (std::size_t i = 0; i < n;) {
     const unsigned char c = static_cast<unsigned char>(word[i]);
-    s += c < 0x20 || c == 0x7f ? '?' : static_cast<char>(c);
+    if (c < 0x80) {
+      s += c < 0x20 || c == 0x7f ? '?' : static_cast<char>(c);
+      ++i;
+      continue;
+    }
+    // A whole, valid UTF-8 sequence is kept; any other byte becomes '?' (the message stays
+    // valid UTF-8 for terminals and JSON).
+    const std::size_t len = c >= 0xF0 && c <= 0xF4 ? 4 : c >= 0xE0 ? 3 : c >= 0xC2 && c <= 0xDF ? 2 : 0;
+    bool ok = len > 0 && len <= 4 && i + len <= n;
+    for (std::size_t k = 1; ok && k < len; ++k) ok = (static_cast<unsigned char>(word[i + k]) & 0xC0) == 0x80;
+    if (ok) {
+      s.append(word.substr(i, len));
+      i += len;
+    } else {
+      s += '?';
+      ++i;
+    }
   }
   if (word.size() > max) s += "...";
   return s;

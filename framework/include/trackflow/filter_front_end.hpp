@@ -256,7 +256,8 @@ class FilterFrontEnd : public Filter {
   // One sum per block: NaN or infinity anywhere makes it non-finite (so does a sum beyond 1e308,
   // which is no usable state either). Cheaper than an element-wise test on the hot path.
   static bool finite(const Estimate& e) {
-    return std::isfinite(e.state.sum() + e.covariance.sum() + e.enu.sum() + e.enu_covariance.sum());
+    return std::isfinite(e.state.sum() + e.covariance.sum() + e.enu.sum() + e.enu_covariance.sum() + e.nis +
+                         e.innovation.sum() + e.innovation_covariance.sum());
   }
 
   FrontEndSpec spec_;

@@ -272,7 +272,7 @@ class CsvSink final : public Component {
     // A NaN that reached the file is written as "nan", never hidden as an empty (missing) cell,
     // and it fails the run: some upstream node produced it.
     if (non_finite_total_)
-      throw DataError("sink.csv (node '" + ctx.node + "') wrote " + std::to_string(non_finite_total_) +
+      throw DataError("wrote " + std::to_string(non_finite_total_) +
                       " non-finite value(s) (nan/inf) into " + file_path_.string() + ", the first in " +
                       first_non_finite_total_ + "; an upstream node produced them");
   }
