@@ -258,6 +258,13 @@ std::vector<ExpectConfig> parse_expect(const std::string& key, const SourceLoc& 
 
 }  // namespace
 
+Value::Value() = default;
+Value::Value(const Value&) = default;
+Value::Value(Value&&) noexcept = default;
+Value& Value::operator=(const Value&) = default;
+Value& Value::operator=(Value&&) noexcept = default;
+Value::~Value() = default;
+
 const Value* Value::find(const std::string& key) const {
   for (const auto& [k, v] : entries)
     if (k == key) return &v;

@@ -28,6 +28,15 @@ struct Value {
   SourceLoc key_loc(const std::string& key) const;
   bool is_scalar() const { return kind == Kind::Scalar; }
   std::string describe() const;  // "a map", "a list", "'abc'"
+
+  // Out of line (config.cpp): inline ones would instantiate std::pair<std::string, Value>
+  // while Value is incomplete, which clang refuses.
+  Value();
+  Value(const Value&);
+  Value(Value&&) noexcept;
+  Value& operator=(const Value&);
+  Value& operator=(Value&&) noexcept;
+  ~Value();
 };
 
 // Limits on what a pipeline file may ask of the loader, so a hostile or broken file ends in a
