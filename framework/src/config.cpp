@@ -2,6 +2,7 @@
 #include <trackflow/host/config.hpp>
 #include <trackflow/host/suggest.hpp>
 
+#include <yaml-cpp/eventhandler.h>
 #include <yaml-cpp/yaml.h>
 
 #include <algorithm>
@@ -10,6 +11,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <sstream>
 #include <unordered_map>
 
 namespace trackflow::host {
@@ -74,22 +76,48 @@ Value convert(const YAML::Node& n, Expansion& x) {
   return v;
 }
 
+// Parses without building anything; remembers where the last document started.
+struct SecondDocument : YAML::EventHandler {
+  YAML::Mark start;
+  void OnDocumentStart(const YAML::Mark& m) override { start = m; }
+  void OnDocumentEnd() override {}
+  void OnNull(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnAlias(const YAML::Mark&, YAML::anchor_t) override {}
+  void OnScalar(const YAML::Mark&, const std::string&, YAML::anchor_t, const std::string&) override {}
+  void OnSequenceStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+  void OnSequenceEnd() override {}
+  void OnMapStart(const YAML::Mark&, const std::string&, YAML::anchor_t, YAML::EmitterStyle::value) override {}
+  void OnMapEnd() override {}
+};
+
 Value parse_text(const std::string& text, const std::string& name) {
   if (text.size() > kMaxYamlBytes)
     throw ConfigError("'" + name + "' is larger than " + std::to_string(kMaxYamlBytes / 1024) +
                       " KiB; a pipeline file is far smaller");
-  std::vector<YAML::Node> docs;
+  YAML::Node doc;
   try {
-    docs = YAML::LoadAll(text);
+    doc = YAML::Load(text);
+    // A second document would otherwise be ignored without a word. (Not YAML::LoadAll: in
+    // yaml-cpp 0.7 it loops forever on some malformed input, e.g. "[|".)
+    std::istringstream in(text);
+    YAML::Parser parser(in);
+    SecondDocument probe;
+    if (parser.HandleNextDocument(probe)) {
+      const YAML::Mark first = probe.start;
+      if (parser.HandleNextDocument(probe)) {
+        // A parser that stays where it was has not understood the first document.
+        if (probe.start.pos <= first.pos)
+          throw ConfigError("YAML syntax error: this cannot be read as YAML", loc_of(probe.start, name));
+        throw ConfigError("a second YAML document ('---') in one file; a pipeline is one document",
+                          loc_of(probe.start, name));
+      }
+    }
   } catch (const YAML::Exception& e) {
     throw ConfigError("YAML syntax error: " + e.msg, loc_of(e.mark, name));
   }
-  // A second document would otherwise be ignored without a word.
-  if (docs.size() > 1)
-    throw ConfigError("a second YAML document ('---') in one file; a pipeline is one document", loc_of(docs[1].Mark(), name));
   Expansion x{name};
   try {
-    return convert(docs.empty() ? YAML::Node() : docs.front(), x);
+    return convert(doc, x);
   } catch (const YAML::Exception& e) {
     throw ConfigError("YAML error: " + e.msg, loc_of(e.mark, name));
   }

@@ -14,7 +14,10 @@ expect_run "the same through --set" 2 "--set kf.q:1:1: an alias refers to a node
 expect_run "a 512-byte alias bomb stops at the expansion limit" 2 \
   "billion_laughs.yaml:[0-9]+:[0-9]+: the YAML expands to more than 250000 values" -- "$TF" validate "$INPUTS/billion_laughs.yaml"
 expect_run "a second YAML document is refused, not ignored" 2 \
-  "second_document.yaml:5:1: a second YAML document" -- "$TF" validate "$INPUTS/second_document.yaml"
+  "second_document.yaml:3:1: a second YAML document" -- "$TF" validate "$INPUTS/second_document.yaml"
+expect_run "input on which yaml-cpp's LoadAll loops forever is exit 2, not a hang" 2 \
+  "yaml_cpp_loop.yaml:[0-9]+:[0-9]+: YAML syntax error" -- timeout 20 "$TF" validate "$INPUTS/yaml_cpp_loop.yaml"
+expect_run "a lone comma too" 2 "YAML syntax error" -- timeout 20 "$TF" validate --set "kf.q=," "$INPUTS/../../cli/data/determinism.yaml"
 expect_run "validate /dev/zero stops at the size limit" 2 "'/dev/zero' is larger than 2048 KiB" -- "$TF" validate /dev/zero
 { base; printf '# %*s\n' 3000000 x; } > "$TMP/big.yaml"
 expect_run "a 3 MB file is refused before it is parsed" 2 "big.yaml' is larger than 2048 KiB" -- "$TF" validate "$TMP/big.yaml"
