@@ -24,7 +24,7 @@ std::string kinds(ItemMask m) {
 
 std::string unknown_type_message(const std::string& type, const PluginRegistry& reg) {
   const auto names = reg.type_names();
-  std::string m = "unknown type '" + type + "'" + did_you_mean(type, names) + ". Available: " +
+  std::string m = "unknown type '" + quote_token(type) + "'" + did_you_mean(type, names) + ". Available: " +
                   (names.empty() ? "none" : join(names)) + ". Searched: " + join(reg.searched());
   for (const auto& p : reg.problems()) m += "\n  plugin not loaded: " + p.str();
   return m;
@@ -63,7 +63,7 @@ Graph build_graph(PipelineConfig cfg, const PluginRegistry& registry) {
       const auto& in = nc.inputs[k];
       auto it = index.find(in);
       if (it == index.end())
-        throw ConfigError("input '" + in + "' is not a node" + did_you_mean(in, ids) + "; nodes: " + join(ids),
+        throw ConfigError("input '" + quote_token(in) + "' is not a node" + did_you_mean(in, ids) + "; nodes: " + join_some(ids),
                           nc.input_locs[k], nc.id);
       if (in == nc.id) throw ConfigError("node takes its own output as input (a cycle)", nc.input_locs[k], nc.id);
       n.inputs.push_back(it->second);
@@ -82,7 +82,7 @@ Graph build_graph(PipelineConfig cfg, const PluginRegistry& registry) {
       if (nc.attach_to.empty())
         throw ConfigError("adapter needs 'attach_to: <filter id>' naming the filter it retunes", nc.loc, nc.id);
     } else if (!nc.attach_to.empty()) {
-      throw ConfigError("'attach_to' is only for adapters; " + nc.type + " is a " + to_string(d.kind), nc.attach_loc,
+      throw ConfigError("'attach_to' is only for adapters; " + quote_token(nc.type) + " is a " + to_string(d.kind), nc.attach_loc,
                         nc.id);
     }
     g.nodes.push_back(std::move(n));
@@ -104,7 +104,7 @@ Graph build_graph(PipelineConfig cfg, const PluginRegistry& registry) {
     if (!n.config.attach_to.empty()) {
       auto it = index.find(n.config.attach_to);
       if (it == index.end())
-        throw ConfigError("attach_to '" + n.config.attach_to + "' is not a node" + did_you_mean(n.config.attach_to, ids),
+        throw ConfigError("attach_to '" + quote_token(n.config.attach_to) + "' is not a node" + did_you_mean(n.config.attach_to, ids),
                           n.config.attach_loc, n.config.id);
       if (g.nodes[it->second].type->decl.kind != ComponentKind::Filter)
         throw ConfigError("attach_to '" + n.config.attach_to + "' is a " +

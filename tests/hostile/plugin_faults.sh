@@ -29,6 +29,7 @@ expect_run "a segmentation fault prints the node being executed and the run" 3 \
 expect_run "... on a worker thread too" 3 "crash \(SIGSEGV, invalid memory access\) in $who during run 1" -- run segfault --threads 2
 expect_run "a stack overflow in a plugin is reported, not a silent death" 3 \
   "crash \(SIGSEGV, invalid memory access\) in $who during run 1" -- run stack_overflow --threads 2
+expect_run "... also on the main thread (one thread runs there)" 3 "crash \(SIGSEGV, invalid memory access\) in $who during run 1" -- run stack_overflow
 expect_run "an abort in a plugin is reported" 3 "crash \(SIGABRT, abort\) in $who during run 1" -- run abort
 
 expect_run "validate never runs the plugin's item code" 0 "ok" -- "$TF" validate "$TMP/segfault.yaml" --plugin-path "$MIS"

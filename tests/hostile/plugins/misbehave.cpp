@@ -3,6 +3,7 @@
 #include <trackflow/plugin.hpp>
 
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
 #include <limits>
 #include <stdexcept>
@@ -44,8 +45,9 @@ class Misbehave final : public Component {
       case What::ThrowInt: throw 42;
       case What::ThrowData: throw DataError("a deliberate data error");
       case What::Segfault: {
-        static volatile int* volatile nowhere = nullptr;
-        *nowhere = 1;
+        // Not null: a null store is caught by UBSan before it faults; page 0 faults in any build.
+        static volatile std::uintptr_t address = 16;
+        *reinterpret_cast<volatile int*>(address) = 1;
         return;
       }
       case What::StackOverflow: (void)recurse(0); return;
