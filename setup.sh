@@ -1,32 +1,39 @@
 #!/usr/bin/env bash
-# Purpose: one-command set-up on Debian bookworm: install missing packages, build what the mode needs, then run the
-# quickstart pipeline (`setup.sh run`), the whole test suite (`setup.sh test`) or build the benchmarks (`setup.sh bench`).
+# Purpose: one-command set-up on Debian bookworm: install missing packages, build what the mode needs, then
+# run the quickstart pipeline (`setup.sh run`), the whole test suite (`setup.sh test`), build the
+# benchmarks (`setup.sh bench`), or run the suite built with AddressSanitizer and
+# UndefinedBehaviorSanitizer (`setup.sh sanitize`).
 set -euo pipefail
 cd "$(dirname "$0")"
 mode=${1:-run}
-BUILD=${TRACKFLOW_BUILD_DIR:-build}
+case "$mode" in
+  run | test | bench) BUILD=${TRACKFLOW_BUILD_DIR:-build} ;;
+  sanitize) BUILD=${TRACKFLOW_BUILD_DIR:-build-sanitize} ;;
+  *)
+    echo "usage: setup.sh [run|test|bench|sanitize]" >&2
+    exit 2
+    ;;
+esac
 
 # Building and running (MPI: Open MPI through Boost.MPI, for `mpirun -np N trackflow run`).
 packages=(g++ cmake ninja-build ccache pkg-config libeigen3-dev libboost-dev libboost-program-options-dev
-          libyaml-cpp-dev catch2 nlohmann-json3-dev libboost-mpi-dev openmpi-bin)
+          libyaml-cpp-dev catch2 nlohmann-json3-dev libgeographiclib-dev libboost-mpi-dev openmpi-bin)
 case "$mode" in
   run)
     # Only what running needs: the library, the CLI and the plugins.
     options=(-DTRACKFLOW_BUILD_TESTS=OFF -DTRACKFLOW_BUILD_BENCH=OFF)
     ;;
-  test)
-    # The headless-browser test of the report (tests/report/browser.sh) and a font for its screenshot.
-    packages+=(chromium fonts-dejavu-core)
+  test | sanitize)
+    # The headless-browser test of the report (tests/report/browser.sh) and a font for its
+    # screenshot; clang++ and libFuzzer for the fuzz harnesses (tests/fuzz) and the clang build of
+    # the SDK. Benchmarks are not built for tests (and mean nothing under ASan).
+    packages+=(chromium fonts-dejavu-core clang libfuzzer-14-dev)
     options=(-DTRACKFLOW_BUILD_TESTS=ON -DTRACKFLOW_BUILD_BENCH=OFF)
     ;;
   bench)
     # The benchmarks (docs/performance.md), with OpenCV's cv::KalmanFilter as the Kalman step's peer.
     packages+=(libopencv-video-dev)
     options=(-DTRACKFLOW_BUILD_TESTS=OFF -DTRACKFLOW_BUILD_BENCH=ON)
-    ;;
-  *)
-    echo "usage: setup.sh [run|test|bench]" >&2
-    exit 2
     ;;
 esac
 missing=()
@@ -42,7 +49,18 @@ if [ ${#missing[@]} -gt 0 ]; then
 fi
 
 echo "== configuring and building in $BUILD/ ($mode)"
-cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release "${options[@]}" >/dev/null
+if [ "$mode" = sanitize ]; then
+  # -fno-gnu-unique: plugins' inline statics stay local to each .so (unique symbols would bind
+  # them across libraries). Benchmarks are not built: their timings mean nothing under ASan.
+  san="-fsanitize=address,undefined -fno-sanitize-recover=undefined -fno-omit-frame-pointer -fno-gnu-unique"
+  # -O1 -g1: half the compile time of -O2 -g, and reports still carry file:line.
+  cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo "${options[@]}" \
+    -DCMAKE_CXX_FLAGS_RELWITHDEBINFO="-O1 -g1 -DNDEBUG" \
+    -DCMAKE_CXX_FLAGS="$san" -DCMAKE_EXE_LINKER_FLAGS="-fsanitize=address,undefined" \
+    -DCMAKE_SHARED_LINKER_FLAGS="-fsanitize=address,undefined" -DCMAKE_MODULE_LINKER_FLAGS="-fsanitize=address,undefined" >/dev/null
+else
+  cmake -S . -B "$BUILD" -G Ninja -DCMAKE_BUILD_TYPE=Release "${options[@]}" >/dev/null
+fi
 cmake --build "$BUILD" -j2
 
 case "$mode" in
@@ -56,5 +74,33 @@ case "$mode" in
     ;;
   bench)
     echo "== built: $BUILD/bin/trackflow-bench, trackflow-bench-filters, trackflow-bench-gain-transform (docs/performance.md)"
+    ;;
+  sanitize)
+    # A report stops the process with exit code 86, which no test expects. ASan and LSan reports
+    # also go to files under $BUILD/sanitizer-reports (found even where a test ignores an exit
+    # code); UBSan's go to stderr (GCC's runtime ignores its log_path next to ASan), so the ctest
+    # log is searched for them too.
+    reports="$(pwd)/$BUILD/sanitizer-reports"
+    rm -rf "$reports" && mkdir -p "$reports"
+    export ASAN_OPTIONS="log_path=$reports/asan:exitcode=86:detect_leaks=1:verify_asan_link_order=0:detect_stack_use_after_return=0"
+    export UBSAN_OPTIONS="log_path=$reports/ubsan:exitcode=86:halt_on_error=1:print_stacktrace=1"
+    export LSAN_OPTIONS="suppressions=$(pwd)/tests/sanitize/lsan.supp"
+    export TRACKFLOW_SANITIZE=1  # scripts that cannot run under ASan (address-space limits) skip, saying so
+    echo "== ctest (ASan + UBSan)"
+    start=$(date +%s)
+    rc=0
+    ctest --test-dir "$BUILD" -j2 --output-on-failure --timeout 1800 || rc=$?
+    echo "== ctest took $(( $(date +%s) - start )) s"
+    if ls "$reports"/* >/dev/null 2>&1; then
+      echo "== sanitizer reports:"
+      for f in "$reports"/*; do echo "---- $f"; head -n 40 "$f"; done
+      exit 1
+    fi
+    if grep -E "runtime error:|ERROR: (AddressSanitizer|LeakSanitizer)" "$BUILD/Testing/Temporary/LastTest.log"; then
+      echo "== sanitizer reports in the test output (above)"
+      exit 1
+    fi
+    echo "== 0 sanitizer reports"
+    exit "$rc"
     ;;
 esac

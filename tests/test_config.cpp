@@ -89,3 +89,56 @@ TEST_CASE("overrides from the command line replace or add parameters") {
   CHECK_THROWS_WITH(parse_pipeline(v, "p.yaml", {parse_override("kff.q=4")}), Catch::Contains("did you mean 'kf'"));
   CHECK_THROWS_AS(parse_override("kfq4"), ConfigError);
 }
+
+TEST_CASE("a list of checks puts several checks on one metric") {
+  const std::string head = "pipeline: {name: a}\nnodes:\n  - {id: s, type: sink.metrics}\nexpect:\n";
+  auto cfg = parse_pipeline(
+      load_yaml_string(head + "  s.position_rmse: [{ max: 5 }, { less_than: b.position_rmse }, { min: 1, max: 4 }]\n", "p.yaml"),
+      "p.yaml");
+  REQUIRE(cfg.expects.size() == 4);
+  CHECK(cfg.expects[0].op == "max");
+  CHECK(cfg.expects[0].value == 5.0);
+  CHECK(cfg.expects[1].op == "less_than");
+  CHECK(cfg.expects[1].ref_node == "b");
+  CHECK(cfg.expects[2].op == "min");
+  CHECK(cfg.expects[3].op == "max");
+  for (const auto& e : cfg.expects) CHECK(e.metric == "position_rmse");
+  CHECK_THROWS_WITH(parse_pipeline(load_yaml_string(head + "  s.anees: []\n", "p.yaml"), "p.yaml"),
+                    Catch::Contains("empty list"));
+  CHECK_THROWS_WITH(parse_pipeline(load_yaml_string(head + "  s.anees: [{ maxx: 1 }]\n", "p.yaml"), "p.yaml"),
+                    Catch::Contains("did you mean 'max'"));
+}
+
+// The top-level sites: map becomes a list of records with the site's name first, located where
+// the analyst wrote them; pipeline.frame_origin must name one of them.
+TEST_CASE("sites and frame_origin are parsed and checked") {
+  const std::string nodes = "nodes:\n  - {id: a, type: x}\n";
+  const std::string sites =
+      "sites:\n  naro: { latitude: 34.43 deg, longitude: 127.53 deg }\n  jeju: { latitude: 33.28 deg, longitude: "
+      "126.46 deg, height: 100 m }\n";
+  auto cfg = parse_pipeline(load_yaml_string("pipeline: {name: a, frame_origin: jeju}\n" + sites + nodes, "p.yaml"),
+                            "p.yaml");
+  REQUIRE(cfg.sites.items.size() == 2);
+  CHECK(cfg.sites.items[1].entries.front().first == "name");
+  CHECK(cfg.sites.items[1].entries.front().second.scalar == "jeju");
+  CHECK(cfg.sites.items[1].find("height")->scalar == "100 m");
+  CHECK(cfg.sites.items[1].find("height")->loc.line == 4);
+  CHECK(cfg.frame_origin.scalar == "jeju");
+  auto err = [&](const std::string& yaml) -> std::string {
+    try {
+      parse_pipeline(load_yaml_string(yaml, "p.yaml"), "p.yaml");
+    } catch (const ConfigError& e) {
+      return e.message();
+    }
+    return "no error";
+  };
+  CHECK_THAT(err("pipeline: {name: a, frame_origin: jeu}\n" + sites + nodes),
+             Catch::Contains("p.yaml:1:35: frame_origin 'jeu' is not a site (did you mean 'jeju'?); sites: naro, jeju"));
+  CHECK_THAT(err("pipeline: {name: a, frame_origin: jeju}\n" + nodes), Catch::Contains("no 'sites:' section"));
+  CHECK_THAT(err("pipeline: {name: a, frame_origin: naro}\nsites: [naro]\n" + nodes), Catch::Contains("'sites' must be a map"));
+  CHECK_THAT(err("pipeline: {name: a, frame_origin: naro}\nsites: { naro: 34 }\n" + nodes), Catch::Contains("site 'naro' must be a map"));
+  CHECK_THAT(err("pipeline: {name: a, frame_origin: naro}\nsites: { naro: { name: x, latitude: 1 } }\n" + nodes),
+             Catch::Contains("remove 'name'"));
+  CHECK_THAT(err("pipeline: {name: a}\n" + sites + nodes), Catch::Contains("'sites' needs 'frame_origin: <site>'"));
+  CHECK(err("pipeline: {name: a, frame_origin: naro}\n" + sites + nodes) == "no error");
+}

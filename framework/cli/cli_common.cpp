@@ -1,6 +1,16 @@
 // Purpose: plugin search options and option parsing shared by the CLI commands.
 #include "cli_common.hpp"
 
+#include <trackflow/host/suggest.hpp>
+#include <trackflow/output_path.hpp>
+
+#include <unistd.h>
+
+#include <cctype>
+#include <cerrno>
+#include <charconv>
+#include <cstring>
+#include <filesystem>
 #include <iostream>
 
 namespace trackflow::cli {
@@ -8,22 +18,101 @@ namespace trackflow::cli {
 po::options_description common_options(Common& c) {
   po::options_description o("Plugin options");
   o.add_options()("plugin-path", po::value(&c.plugin_paths)->composing(),
-                  "also search DIR for tfplugin_*.so (repeatable; searched first)")(
+                  "also search DIR for tfplugin_*.so (repeatable; after the built-in folder)")(
       "no-default-plugins", po::bool_switch(&c.no_default_plugins),
-      "do not search $TRACKFLOW_PLUGIN_PATH or the built-in plugin folder");
+      "do not search $TRACKFLOW_PLUGIN_PATH or the built-in plugin folder")(
+      "replace-type", po::value(&c.replace_types)->composing(),
+      "let a plugin from --plugin-path or $TRACKFLOW_PLUGIN_PATH replace this built-in TYPE (repeatable); "
+      "otherwise built-in types are never replaced");
   return o;
 }
 
-host::PluginRegistry load_plugins(const Common& c, const std::vector<std::string>& pipeline_paths) {
-  std::vector<std::string> dirs = c.plugin_paths;
-  dirs.insert(dirs.end(), pipeline_paths.begin(), pipeline_paths.end());
-  if (!c.no_default_plugins) {
-    auto d = host::default_plugin_dirs();
-    dirs.insert(dirs.end(), d.begin(), d.end());
-  }
+po::options_description trust_options(Common& c) {
+  po::options_description o("Trust options (a pipeline file alone can neither load code nor write outside --out)");
+  o.add_options()("trust-plugin-paths", po::bool_switch(&c.trust_plugin_paths),
+                  "load plugins from the folders the pipeline's plugin_paths: names (refused otherwise)")(
+      "allow-outside-out", po::bool_switch(&c.allow_outside_out),
+      "let sinks write to absolute paths or paths with '..' (otherwise only under --out)");
+  return o;
+}
+
+host::PluginRegistry load_plugins(const Common& c, const host::PipelineConfig* pipeline) {
+  if (pipeline && !pipeline->plugin_paths.empty() && !c.trust_plugin_paths)
+    throw ConfigError("this pipeline asks to load plugins from " + host::join_some(pipeline->plugin_paths, 5) +
+                          " (plugin_paths:); a pipeline file cannot make trackflow run code: pass --plugin-path DIR, "
+                          "or --trust-plugin-paths if you trust this file and those folders",
+                      pipeline->plugin_paths_loc);
   host::PluginRegistry reg;
-  reg.load_directories(dirs);
+  reg.allow_replacing(c.replace_types);
+  if (!c.no_default_plugins) reg.load_directories(host::builtin_plugin_dirs(), true);
+  reg.load_directories(c.plugin_paths);
+  if (pipeline) reg.load_directories(pipeline->plugin_paths);
+  if (!c.no_default_plugins) reg.load_directories(host::environment_plugin_dirs());
   return reg;
+}
+
+void apply_trust(const Common& c) { allow_output_outside(c.allow_outside_out); }
+
+std::uint64_t parse_count(const std::string& text, const std::string& option, std::uint64_t min, std::uint64_t max) {
+  std::uint64_t v = 0;
+  const char* end = text.data() + text.size();
+  const auto [ptr, ec] = std::from_chars(text.data(), end, v);
+  const bool digits = !text.empty() && std::isdigit(static_cast<unsigned char>(text[0]));
+  if (!digits || ec != std::errc() || ptr != end || v < min || v > max)
+    throw ConfigError(option + " must be a whole number from " + std::to_string(min) + " to " + std::to_string(max) +
+                      ", got '" + host::quote_token(text) + "'");
+  return v;
+}
+
+namespace {
+
+namespace fs = std::filesystem;
+
+// The nearest existing folder at or above `p`, or empty.
+fs::path existing_ancestor(fs::path p) {
+  std::error_code ec;
+  if (p.empty()) p = ".";
+  p = fs::absolute(p, ec);
+  while (!p.empty()) {
+    if (fs::exists(p, ec)) return p;
+    if (p == p.parent_path()) break;
+    p = p.parent_path();
+  }
+  return {};
+}
+
+void check_parent_writable(const fs::path& p, const std::string& option, const std::string& path) {
+  const fs::path ancestor = existing_ancestor(p);
+  std::error_code ec;
+  if (ancestor.empty() || !fs::is_directory(ancestor, ec))
+    throw ConfigError(option + " '" + path + "': '" + ancestor.string() + "' is not a folder");
+  if (::access(ancestor.c_str(), W_OK | X_OK) != 0)
+    throw ConfigError(option + " '" + path + "': cannot write in '" + ancestor.string() + "': " + std::strerror(errno));
+}
+
+}  // namespace
+
+void check_output_file(const std::string& path, const std::string& option) {
+  std::error_code ec;
+  const fs::path p(path);
+  if (path.empty()) throw ConfigError(option + " needs a file name");
+  if (fs::is_directory(p, ec)) throw ConfigError(option + " '" + path + "' is a folder, not a file");
+  if (fs::exists(p, ec)) {
+    if (::access(p.c_str(), W_OK) != 0) throw ConfigError(option + " '" + path + "': " + std::strerror(errno));
+    return;
+  }
+  check_parent_writable(p.parent_path(), option, path);
+}
+
+void check_output_folder(const std::string& path, const std::string& option) {
+  std::error_code ec;
+  const fs::path p(path);
+  if (fs::exists(p, ec)) {
+    if (!fs::is_directory(p, ec)) throw ConfigError(option + " '" + path + "' exists and is not a folder");
+    if (::access(p.c_str(), W_OK | X_OK) != 0) throw ConfigError(option + " '" + path + "': " + std::strerror(errno));
+    return;
+  }
+  check_parent_writable(p, option, path);
 }
 
 void warn_problems(const host::PluginRegistry& reg) {

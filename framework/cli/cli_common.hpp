@@ -1,11 +1,13 @@
 // Purpose: what the CLI commands share: exit codes, plugin search options, option parsing.
 #pragma once
 
+#include <trackflow/host/config.hpp>
 #include <trackflow/host/mpi.hpp>
 #include <trackflow/host/plugins.hpp>
 
 #include <boost/program_options.hpp>
 
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -17,12 +19,30 @@ constexpr int kOk = 0, kExpectFailed = 1, kBadInput = 2, kInternal = 3;
 
 struct Common {
   std::vector<std::string> plugin_paths;
+  std::vector<std::string> replace_types;
   bool no_default_plugins = false;
+  // Trust: what only the command line may allow (docs/architecture.md, "Trust").
+  bool trust_plugin_paths = false;
+  bool allow_outside_out = false;
 };
 
 po::options_description common_options(Common& c);
-// --plugin-path dirs, then the pipeline's plugin_paths, then the defaults (unless disabled).
-host::PluginRegistry load_plugins(const Common& c, const std::vector<std::string>& pipeline_paths);
+// For the commands that open a pipeline (run, report, validate, sweep).
+po::options_description trust_options(Common& c);
+// The built-in plugin folder first (its types are replaced only by --replace-type), then
+// --plugin-path, the pipeline's plugin_paths (only with --trust-plugin-paths: a pipeline file
+// cannot make trackflow load code), then $TRACKFLOW_PLUGIN_PATH.
+host::PluginRegistry load_plugins(const Common& c, const host::PipelineConfig* pipeline = nullptr);
+// Applies --allow-outside-out for the sinks built after this call.
+void apply_trust(const Common& c);
+
+// A whole number given on the command line, checked against [min, max]: "-1", "1e3", "12abc"
+// and values beyond 64 bits are refused instead of wrapping.
+std::uint64_t parse_count(const std::string& text, const std::string& option, std::uint64_t min, std::uint64_t max);
+// Refuses, before anything runs, an output file (or folder) that cannot be written: a folder
+// where a file is wanted, a parent that is a file or not writable. Creates nothing.
+void check_output_file(const std::string& path, const std::string& option);
+void check_output_folder(const std::string& path, const std::string& option);
 void warn_problems(const host::PluginRegistry& reg);
 // Parses argv after the command word; prints help and returns false when asked.
 bool parse(int argc, char** argv, po::options_description& opts, po::positional_options_description& pos,

@@ -3,6 +3,7 @@
 #include "report_command.hpp"
 
 #include <trackflow/host/engine.hpp>
+#include <trackflow/host/guard.hpp>
 #include <trackflow/host/report.hpp>
 #include <trackflow/host/suggest.hpp>
 #include <trackflow/host/validate.hpp>
@@ -14,6 +15,10 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <iomanip>
 #include <iostream>
@@ -43,11 +48,15 @@ Commands:
 
 Run `trackflow <command> --help` for the options of a command.
 
-Exit codes: 0 ok, 1 an `expect` check failed, 2 bad configuration or input data,
-3 internal error.
-Plugins are searched in: --plugin-path DIRs, the pipeline's plugin_paths,
-$TRACKFLOW_PLUGIN_PATH (colon-separated), then <trackflow>/../lib/trackflow/plugins.
+Exit codes: 0 ok, 1 an `expect` check failed, 2 bad configuration or input data
+(or an output that cannot be written), 3 internal error (a bug, also a crash in a plugin).
+Plugins are searched in: <trackflow>/../lib/trackflow/plugins (built in), --plugin-path
+DIRs, the pipeline's plugin_paths (only with --trust-plugin-paths), then
+$TRACKFLOW_PLUGIN_PATH (colon-separated). Built-in types are replaced only with --replace-type.
 )";
+
+// The thread counts accepted; 0 means one per core.
+constexpr std::uint64_t kMaxThreads = 1024;
 
 struct Loaded {
   PipelineConfig cfg;
@@ -61,10 +70,11 @@ Loaded load_pipeline(const std::string& file, const std::vector<std::string>& se
                      long long track_run = -1, std::string* track_node = nullptr) {
   std::vector<Override> overrides;
   for (const auto& s : sets) overrides.push_back(parse_override(s));
+  apply_trust(c);
   Value root = load_yaml_file(file);
   Loaded l;
   l.cfg = parse_pipeline(root, file, overrides);
-  l.reg = load_plugins(c, l.cfg.plugin_paths);
+  l.reg = load_plugins(c, &l.cfg);
   warn_problems(l.reg);
   if (track_run >= 0 && track_node && l.reg.find("sink.track"))
     *track_node = add_track_recorder(l.cfg, l.reg, static_cast<std::uint64_t>(track_run));
@@ -77,15 +87,15 @@ int cmd_run(int argc, char** argv, bool report_mode = false) {
   Common c;
   std::string file, out_dir, metrics_json, report_html;
   std::vector<std::string> sets;
-  std::uint64_t runs = 0, seed = 0, track_run = 0;
-  unsigned threads = 1;
+  // Numbers are read as text and checked here: program_options would wrap "-1" into 2^64-1.
+  std::string runs_text, seed_text, threads_text = "1", track_run_text = "0";
   bool quiet = false, no_progress = false, series = false;
   po::options_description o(report_mode ? "trackflow report options" : "trackflow run options");
   o.add_options()("help,h", "show this help")("file", po::value(&file), "pipeline YAML file")(
-      "runs,n", po::value(&runs), "Monte Carlo runs (default: the pipeline's `runs:`)")(
-      "threads,j", po::value(&threads)->default_value(1),
-      "worker threads; results are identical for any value")(
-      "seed", po::value(&seed), "base seed (default: the pipeline's `seed:`)")(
+      "runs,n", po::value(&runs_text), "Monte Carlo runs (default: the pipeline's `runs:`)")(
+      "threads,j", po::value(&threads_text)->default_value("1"),
+      "worker threads, 0: one per core (at most 1024); results are identical for any value")(
+      "seed", po::value(&seed_text), "base seed, 0 to 2^64-1 (default: the pipeline's `seed:`)")(
       "set", po::value(&sets)->composing(),
       "override a parameter: --set kf.q=4 --set radar.sigma_range=\"20 m\" (repeatable)")(
       "out,o", po::value(&out_dir), "folder for files written by sinks (default: out/<pipeline name>)")(
@@ -96,10 +106,11 @@ int cmd_run(int argc, char** argv, bool report_mode = false) {
       "into the --out folder")(
       "report", po::value(&report_html),
       report_mode ? "the HTML file (default: <out>/report.html)" : "also write the HTML report with plots to this file")(
-      "track-run", po::value(&track_run)->default_value(0), "the run whose track the report draws")(
+      "track-run", po::value(&track_run_text)->default_value("0"), "the run whose track the report draws")(
       "quiet,q", po::bool_switch(&quiet), "print only expect failures and errors")(
       "no-progress", po::bool_switch(&no_progress), "no progress bar even on a terminal");
   o.add(common_options(c));
+  o.add(trust_options(c));
   po::positional_options_description pos;
   pos.add("file", 1);
   po::variables_map vm;
@@ -110,22 +121,32 @@ int cmd_run(int argc, char** argv, bool report_mode = false) {
                          : "Usage: trackflow run FILE [options]"))
     return kOk;
   if (file.empty()) throw po::error(std::string(report_mode ? "report" : "run") + " needs a pipeline FILE");
+  const std::uint64_t max64 = std::numeric_limits<std::uint64_t>::max();
+  const bool runs_given = vm.count("runs") > 0, seed_given = vm.count("seed") > 0;
+  const std::uint64_t runs = runs_given ? parse_count(runs_text, "--runs", 1, max64) : 0;
+  const std::uint64_t seed = seed_given ? parse_count(seed_text, "--seed", 0, max64) : 0;
+  unsigned threads = static_cast<unsigned>(parse_count(threads_text, "--threads", 0, kMaxThreads));
+  const std::uint64_t track_run = parse_count(track_run_text, "--track-run", 0, max64);
   const bool want_report = report_mode || !report_html.empty();
   std::string track_node;
   Loaded l;
-  agreed_setup([&] { l = load_pipeline(file, sets, c, want_report ? static_cast<long long>(track_run) : -1, &track_node); });
+  agreed_setup([&] {
+    l = load_pipeline(file, sets, c,
+                      want_report ? static_cast<long long>(std::min<std::uint64_t>(track_run, 1ull << 62)) : -1,
+                      &track_node);
+  });
   RunOptions ro;
-  ro.runs = vm.count("runs") ? runs : l.graph.config.runs;
+  ro.runs = runs_given ? runs : l.graph.config.runs;
   if (ro.runs == 0) throw ConfigError("--runs must be at least 1");
   if (threads == 0) threads = std::max(1u, std::thread::hardware_concurrency());
   ro.threads = threads;
-  ro.seed = vm.count("seed") ? seed : l.graph.config.seed;
+  ro.seed = seed_given ? seed : l.graph.config.seed;
   l.graph.config.seed = ro.seed;
   ro.output_dir = out_dir.empty() ? (std::filesystem::path("out") / l.graph.config.name).string() : out_dir;
   if (!no_progress && !quiet && is_root() && ::isatty(STDERR_FILENO) && ro.runs > 1) {
     ro.progress = [](std::uint64_t done, std::uint64_t total) {
       const int width = 40;
-      const int filled = static_cast<int>(width * done / std::max<std::uint64_t>(total, 1));
+      const int filled = static_cast<int>(width * (static_cast<double>(done) / static_cast<double>(std::max<std::uint64_t>(total, 1))));
       std::cerr << "\r[" << std::string(filled, '#') << std::string(width - filled, '.') << "] " << done << "/"
                 << total << " runs" << (done == total ? "\n" : "") << std::flush;
     };
@@ -133,6 +154,12 @@ int cmd_run(int argc, char** argv, bool report_mode = false) {
   if (want_report && track_run >= ro.runs)
     throw ConfigError("--track-run " + std::to_string(track_run) + ": there are only " + std::to_string(ro.runs) +
                       " runs (0 to " + std::to_string(ro.runs - 1) + ")");
+  // Every output is checked before the runs: a typo in a path must not cost the whole ensemble.
+  if (is_root()) {
+    if (!out_dir.empty() || series || want_report) check_output_folder(ro.output_dir, "--out");
+    if (!metrics_json.empty()) check_output_file(metrics_json, "--metrics-json");
+    if (!report_html.empty()) check_output_file(report_html, "--report");
+  }
   Outcome out = run_ensemble(l.graph, l.reg, ro);
   if (!is_root()) return kOk;  // rank 0 of the MPI job reports, checks and writes
   auto results = check_expects(l.graph, out);
@@ -167,6 +194,7 @@ int cmd_validate(int argc, char** argv) {
   o.add_options()("help,h", "show this help")("file", po::value(&file), "pipeline YAML file")(
       "set", po::value(&sets)->composing(), "override a parameter, as for run");
   o.add(common_options(c));
+  o.add(trust_options(c));
   po::positional_options_description pos;
   pos.add("file", 1);
   po::variables_map vm;
@@ -187,7 +215,7 @@ int cmd_plugins(int argc, char** argv) {
   po::positional_options_description pos;
   po::variables_map vm;
   if (!parse(argc, argv, o, pos, vm, "Usage: trackflow plugins [--json]\n\nLists plugin files found and the component types each provides; exit 2 if any file failed to load.")) return kOk;
-  PluginRegistry reg = load_plugins(c, {});
+  PluginRegistry reg = load_plugins(c);
   if (json) {
     nlohmann::ordered_json j;
     j["searched"] = reg.searched();
@@ -198,7 +226,7 @@ int cmd_plugins(int argc, char** argv) {
     j["problems"] = nlohmann::ordered_json::array();
     for (const auto& p : reg.problems())
       j["problems"].push_back({{"file", p.file}, {"stage", p.stage}, {"message", p.message}});
-    std::cout << j.dump(2) << "\n";
+    std::cout << j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) << "\n";
   } else {
     std::cout << "searched: " << join(reg.searched()) << "\n";
     // Columns as wide as their longest entry (plus two spaces), so long names never run into the kind.
@@ -303,7 +331,7 @@ int cmd_describe(int argc, char** argv) {
   pos.add("type", 1);
   po::variables_map vm;
   if (!parse(argc, argv, o, pos, vm, "Usage: trackflow describe TYPE | --all [--markdown]")) return kOk;
-  PluginRegistry reg = load_plugins(c, {});
+  PluginRegistry reg = load_plugins(c);
   warn_problems(reg);
   if (all) {
     if (md) std::cout << "# Component reference\n\nGenerated by `trackflow describe --all --markdown` from each plugin's parameter declaration.\n\n";
@@ -323,26 +351,22 @@ std::string rank_prefix(const host::MpiSession* mpi) {
 }
 
 int run_command(const std::string& cmd, int argc, char** argv) {
-  {
-    // Commands that only inspect: one process of an MPI job answers.
-    if (!is_root() && (cmd == "validate" || cmd == "plugins" || cmd == "describe")) return kOk;
-    if (cmd == "run") return cmd_run(argc - 1, argv + 1);
-    if (cmd == "report") return cmd_run(argc - 1, argv + 1, true);
-    if (cmd == "validate") return cmd_validate(argc - 1, argv + 1);
-    if (cmd == "plugins") return cmd_plugins(argc - 1, argv + 1);
-    if (cmd == "describe") return cmd_describe(argc - 1, argv + 1);
-    if (cmd == "sweep") return cmd_sweep(argc - 1, argv + 1);
-    if (is_root())
-      std::cerr << "trackflow: unknown command '" << cmd << "'"
-                << did_you_mean(cmd, {"run", "report", "validate", "plugins", "describe", "sweep"}) << "\n\n"
-                << kTopHelp;
-    return kBadInput;
-  }
+  // Commands that only inspect: one process of an MPI job answers.
+  if (!is_root() && (cmd == "validate" || cmd == "plugins" || cmd == "describe")) return kOk;
+  if (cmd == "run") return cmd_run(argc - 1, argv + 1);
+  if (cmd == "report") return cmd_run(argc - 1, argv + 1, true);
+  if (cmd == "validate") return cmd_validate(argc - 1, argv + 1);
+  if (cmd == "plugins") return cmd_plugins(argc - 1, argv + 1);
+  if (cmd == "describe") return cmd_describe(argc - 1, argv + 1);
+  if (cmd == "sweep") return cmd_sweep(argc - 1, argv + 1);
+  if (is_root())
+    std::cerr << "trackflow: unknown command '" << quote_token(cmd) << "'"
+              << did_you_mean(cmd, {"run", "report", "validate", "plugins", "describe", "sweep"}) << "\n\n"
+              << kTopHelp;
+  return kBadInput;
 }
 
-}  // namespace
-
-int main(int argc, char** argv) {
+int dispatch(int argc, char** argv) {
   if (argc < 2 || std::string(argv[1]) == "--help" || std::string(argv[1]) == "-h" || std::string(argv[1]) == "help") {
     std::cout << kTopHelp;
     return argc < 2 ? kBadInput : kOk;
@@ -372,10 +396,22 @@ int main(int argc, char** argv) {
     if (!quiet()) std::cerr << "trackflow: data error: " << e.what() << "\n";
     code = kBadInput;
   } catch (const po::error& e) {
-    if (!quiet()) std::cerr << "trackflow " << cmd << ": " << e.what() << " (see trackflow " << cmd << " --help)\n";
+    if (!quiet())
+      std::cerr << "trackflow " << quote_token(cmd) << ": " << e.what() << " (see trackflow " << quote_token(cmd)
+                << " --help)\n";
     code = kBadInput;
+  } catch (const InternalError& e) {
+    std::cerr << "trackflow: internal error: " << rank_prefix(mpi.get()) << e.what() << "\n";
+    code = kInternal;
+  } catch (const std::bad_alloc&) {
+    std::cerr << "trackflow: error: " << rank_prefix(mpi.get()) << "out of memory\n";
+    code = kInternal;
   } catch (const std::exception& e) {
     std::cerr << "trackflow: internal error: " << rank_prefix(mpi.get()) << e.what() << "\n";
+    code = kInternal;
+  } catch (...) {
+    std::cerr << "trackflow: internal error: " << rank_prefix(mpi.get())
+              << "an exception that is not a std::exception\n";
     code = kInternal;
   }
   // Every process of an MPI job exits with the job's code (the largest).
@@ -384,3 +420,20 @@ int main(int argc, char** argv) {
   return code;
 }
 
+}  // namespace
+
+int main(int argc, char** argv) {
+  // TRACKFLOW_CRASH_HANDLER=0 leaves fatal signals to the system (a core dump for a debugger).
+  const char* handler = std::getenv("TRACKFLOW_CRASH_HANDLER");
+  if (!handler || std::string(handler) != "0") install_crash_handler();
+  int rc = dispatch(argc, argv);
+  // Whatever was printed must have reached its destination: a full disk is not a success.
+  std::cout.flush();
+  if (!std::cout || std::fflush(stdout) != 0 || std::ferror(stdout)) {
+    const int err = errno;
+    std::cerr << "trackflow: error: cannot write the standard output" << (err ? std::string(": ") + std::strerror(err) : "")
+              << "\n";
+    if (rc == kOk || rc == kExpectFailed) rc = kBadInput;
+  }
+  return rc;
+}

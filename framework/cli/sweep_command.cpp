@@ -21,6 +21,8 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <limits>
+#include <system_error>
 #include <mutex>
 #include <thread>
 
@@ -89,28 +91,34 @@ int cmd_sweep(int argc, char** argv) {
   Common c;
   std::string file, csv_path, report_path;
   std::vector<std::string> params, sets, metric_names;
-  std::uint64_t runs = 0, seed = 0;
-  unsigned threads = 1;
+  std::string runs_text, seed_text, threads_text = "1";
   po::options_description o("trackflow sweep options");
   o.add_options()("help,h", "show this help")("file", po::value(&file), "pipeline YAML file")(
       "param,p", po::value(&params)->composing(), "a grid axis: node.param=v1,v2,... (repeatable)")(
       "metric,m", po::value(&metric_names)->composing(),
       "node.metric to tabulate (repeatable; default: position_rmse, velocity_rmse and anees of every "
-      "node that reports them)")("runs,n", po::value(&runs), "Monte Carlo runs per grid point (default: the pipeline's)")(
-      "threads,j", po::value(&threads)->default_value(1),
-      "grid points run in parallel (in an MPI job: threads per process for each point's runs)")(
-      "seed", po::value(&seed), "base seed (default: the pipeline's)")(
+      "node that reports them)")("runs,n", po::value(&runs_text), "Monte Carlo runs per grid point (default: the pipeline's)")(
+      "threads,j", po::value(&threads_text)->default_value("1"),
+      "grid points run in parallel, at most 1024 (in an MPI job: threads per process for each point's runs)")(
+      "seed", po::value(&seed_text), "base seed, 0 to 2^64-1 (default: the pipeline's)")(
       "set", po::value(&sets)->composing(), "fixed override for every point, as for run")(
       "csv", po::value(&csv_path), "also write the table to this CSV file (SI numbers, units in the header)")(
       "report", po::value(&report_path), "also write an HTML report: each metric against the first numeric axis")(
       "out,o", po::value<std::string>(), "folder for files written by sinks (default: out/<name>/sweep-<i>)");
   o.add(common_options(c));
+  o.add(trust_options(c));
   po::positional_options_description pos;
   pos.add("file", 1);
   po::variables_map vm;
   if (!parse(argc, argv, o, pos, vm, kUsage)) return kOk;
   if (file.empty()) throw po::error("sweep needs a pipeline FILE");
   if (params.empty()) throw po::error("sweep needs at least one --param node.param=v1,v2,...");
+
+  const std::uint64_t max64 = std::numeric_limits<std::uint64_t>::max();
+  const bool runs_given = vm.count("runs") > 0, seed_given = vm.count("seed") > 0;
+  const std::uint64_t runs = runs_given ? parse_count(runs_text, "--runs", 1, max64) : 0;
+  const std::uint64_t seed = seed_given ? parse_count(seed_text, "--seed", 0, max64) : 0;
+  const unsigned threads = static_cast<unsigned>(std::max<std::uint64_t>(1, parse_count(threads_text, "--threads", 0, 1024)));
 
   std::vector<host::SweepAxis> axes;
   for (const auto& p : params) axes.push_back(host::parse_sweep_axis(p));
@@ -119,13 +127,14 @@ int cmd_sweep(int argc, char** argv) {
   const auto grid = host::sweep_grid(axes);
 
   // Build (and so validate) every point's graph before running any: a bad value fails fast.
+  apply_trust(c);
   host::PipelineConfig base;
   host::PluginRegistry reg;
   std::vector<host::Graph> graphs;
   agreed_setup([&] {
     const host::Value root = host::load_yaml_file(file);
     base = host::parse_pipeline(root, file, fixed);
-    reg = load_plugins(c, base.plugin_paths);
+    reg = load_plugins(c, &base);
     warn_problems(reg);
     for (size_t i = 0; i < grid.size(); ++i) {
       auto overrides = fixed;
@@ -139,21 +148,27 @@ int cmd_sweep(int argc, char** argv) {
       }
     }
   });
+  const std::string out_root =
+      vm.count("out") ? vm["out"].as<std::string>() : (std::filesystem::path("out") / base.name).string();
+  // Outputs are checked before the grid runs.
+  if (is_root()) {
+    if (vm.count("out")) check_output_folder(out_root, "--out");
+    if (!csv_path.empty()) check_output_file(csv_path, "--csv");
+    if (!report_path.empty()) check_output_file(report_path, "--report");
+  }
 
   std::vector<host::Outcome> outcomes(grid.size());
   std::atomic<size_t> next{0}, done{0};
   std::exception_ptr error;
   std::mutex error_mutex;
-  const std::string out_root =
-      vm.count("out") ? vm["out"].as<std::string>() : (std::filesystem::path("out") / base.name).string();
   auto worker = [&]() {
     for (;;) {
       const size_t i = next.fetch_add(1);
       if (i >= grid.size()) return;
       try {
         host::RunOptions ro;
-        ro.runs = vm.count("runs") ? runs : graphs[i].config.runs;
-        ro.seed = vm.count("seed") ? seed : graphs[i].config.seed;
+        ro.runs = runs_given ? runs : graphs[i].config.runs;
+        ro.seed = seed_given ? seed : graphs[i].config.seed;
         ro.threads = 1;
         ro.output_dir = (std::filesystem::path(out_root) / ("sweep-" + std::to_string(i))).string();
         outcomes[i] = host::run_graph(graphs[i], reg, ro);
@@ -171,8 +186,8 @@ int cmd_sweep(int argc, char** argv) {
     // (--threads per process); rank 0 merges, writes the sinks' files and prints the table.
     for (size_t i = 0; i < grid.size(); ++i) {
       host::RunOptions ro;
-      ro.runs = vm.count("runs") ? runs : graphs[i].config.runs;
-      ro.seed = vm.count("seed") ? seed : graphs[i].config.seed;
+      ro.runs = runs_given ? runs : graphs[i].config.runs;
+      ro.seed = seed_given ? seed : graphs[i].config.seed;
       ro.threads = std::max(1u, threads);
       ro.output_dir = (std::filesystem::path(out_root) / ("sweep-" + std::to_string(i))).string();
       outcomes[i] = run_ensemble(graphs[i], reg, ro);
@@ -181,9 +196,24 @@ int cmd_sweep(int argc, char** argv) {
     if (!is_root()) return kOk;
   } else {
     std::vector<std::thread> pool;
+    // Every started thread is joined however this block is left (a joinable std::thread
+    // destroyed would terminate the process).
+    struct Joiner {
+      std::vector<std::thread>& pool;
+      ~Joiner() {
+        for (auto& t : pool)
+          if (t.joinable()) t.join();
+      }
+    } joiner{pool};
     const unsigned nthreads = std::max(1u, std::min<unsigned>(threads, static_cast<unsigned>(grid.size())));
-    for (unsigned t = 0; t < nthreads; ++t) pool.emplace_back(worker);
-    for (auto& t : pool) t.join();
+    try {
+      for (unsigned t = 0; t < nthreads; ++t) pool.emplace_back(worker);
+    } catch (const std::system_error& e) {
+      // A process limit: the points that started share the grid; none started: this thread runs it.
+      std::cerr << "trackflow: warning: started " << pool.size() << " of " << nthreads << " threads (" << e.what()
+                << "); the table is the same with fewer\n";
+      if (pool.empty()) worker();
+    }
   }
   if (::isatty(STDERR_FILENO)) std::cerr << "\n";
   if (error) std::rethrow_exception(error);

@@ -145,7 +145,8 @@ class Page {
     charts_.push_back({{"id", id}, {"spec", std::move(spec)}});
   }
   std::string finish(const std::string& title) const {
-    std::string specs = charts_.dump();
+    // Labels come from plugins (metric and series names): invalid UTF-8 becomes U+FFFD, not an exception.
+    std::string specs = charts_.dump(-1, ' ', false, json::error_handler_t::replace);
     // Inside <script>, "</" could end the element; "<\/" is the same JSON string.
     for (size_t p = specs.find("</"); p != std::string::npos; p = specs.find("</", p + 3)) specs.replace(p, 2, "<\\/");
     std::string out;
@@ -587,9 +588,10 @@ void write_text_file(const std::string& path, const std::string& text) {
   std::error_code ec;
   if (!parent.empty()) std::filesystem::create_directories(parent, ec);
   std::ofstream f(path, std::ios::binary | std::ios::trunc);
-  f << text;
-  f.flush();
   if (!f) throw ConfigError("cannot write '" + path + "': " + std::strerror(errno));
+  f << text;
+  f.close();  // a full disk shows at the flush
+  if (f.fail()) throw ConfigError("cannot write '" + path + "': " + std::strerror(errno));
 }
 
 }  // namespace trackflow::report

@@ -5,6 +5,17 @@
 
 namespace trackflow {
 
+namespace detail {
+thread_local constinit Component* executing = nullptr;
+// Set by the engine (host/guard.hpp) for the threads of one ensemble.
+thread_local const std::string* output_dir = nullptr;
+}  // namespace detail
+
+const std::string& output_directory() {
+  static const std::string none;
+  return detail::output_dir ? *detail::output_dir : none;
+}
+
 const char* to_string(ItemKind k) {
   switch (k) {
     case ItemKind::Truth: return "truth";

@@ -1,15 +1,22 @@
 // Purpose: the run loop: time-ordered merge of sources, Monte Carlo runs on worker threads, ordered reduction.
 #include <trackflow/host/engine.hpp>
+#include <trackflow/host/guard.hpp>
 #include <trackflow/rng.hpp>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
+#include <condition_variable>
 #include <cmath>
 #include <exception>
+#include <functional>
 #include <limits>
 #include <map>
 #include <mutex>
+#include <queue>
+#include <system_error>
 #include <thread>
+#include <unordered_map>
 
 namespace trackflow::host {
 namespace {
@@ -22,34 +29,79 @@ struct RunRecord {
 };
 
 // One run on one instance: the generator with the earliest next item goes first; ties go to
-// the generator declared first, so the order never depends on timing.
+// the generator declared first, so the order never depends on timing. A generator whose next
+// time is not a number is exhausted, as one at +infinity.
 std::uint64_t drive(GraphInstance& inst) {
   std::vector<Generator*> gens;
   for (int r : inst.roots) gens.push_back(static_cast<Generator*>(inst.components[r].get()));
   std::uint64_t items = 0;
   if (gens.size() == 1) {
     Generator* g = gens[0];
+    detail::executing = g;
     while (std::isfinite(g->next_time())) {
       g->emit_next();
       ++items;
     }
     return items;
   }
-  for (;;) {
-    Generator* best = nullptr;
-    double t = std::numeric_limits<double>::infinity();
-    for (Generator* g : gens) {
-      const double gt = g->next_time();
-      if (gt < t) {
-        t = gt;
-        best = g;
+  if (gens.size() <= 8) {
+    for (;;) {
+      Generator* best = nullptr;
+      double t = std::numeric_limits<double>::infinity();
+      for (Generator* g : gens) {
+        detail::executing = g;
+        const double gt = g->next_time();
+        if (gt < t) {
+          t = gt;
+          best = g;
+        }
       }
+      if (!best) return items;
+      detail::executing = best;
+      best->emit_next();
+      ++items;
     }
-    if (!best) return items;
-    best->emit_next();
-    ++items;
   }
+  // Many sources: a heap on (time, declaration order) keeps a step logarithmic. Only the
+  // generator that emitted changes its next time (generators have no inputs).
+  using Entry = std::pair<double, std::size_t>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> heap;
+  for (std::size_t i = 0; i < gens.size(); ++i) {
+    detail::executing = gens[i];
+    const double t = gens[i]->next_time();
+    if (t < std::numeric_limits<double>::infinity()) heap.emplace(t, i);
+  }
+  while (!heap.empty()) {
+    const std::size_t i = heap.top().second;
+    heap.pop();
+    detail::executing = gens[i];
+    gens[i]->emit_next();
+    ++items;
+    const double t = gens[i]->next_time();
+    if (t < std::numeric_limits<double>::infinity()) heap.emplace(t, i);
+  }
+  return items;
 }
+
+NodeLabels labels_of(const Graph& g, const GraphInstance& inst) {
+  NodeLabels l;
+  for (std::size_t i = 0; i < g.nodes.size(); ++i) {
+    l.components.push_back(inst.components[i].get());
+    l.labels.push_back("node '" + g.nodes[i].config.id + "' (" + g.nodes[i].config.type + " from " +
+                       g.nodes[i].type->file + ")");
+  }
+  return l;
+}
+
+// Joins every started worker however the coordinating thread leaves (a std::thread destroyed
+// while joinable would terminate the process).
+struct Joiner {
+  std::vector<std::thread>& pool;
+  ~Joiner() {
+    for (auto& t : pool)
+      if (t.joinable()) t.join();
+  }
+};
 
 }  // namespace
 
@@ -79,8 +131,15 @@ Outcome run_graph(const Graph& g, const PluginRegistry& registry, const RunOptio
   for (const auto& n : g.nodes)
     if (n.type->decl.kind == ComponentKind::Filter) ++out.filters;
 
+  std::unordered_map<std::string, std::size_t> node_index;
+  for (size_t i = 0; i < N; ++i) node_index.emplace(out.nodes[i].id, i);
+
   // The aggregating instance is built first so construction errors surface before any thread starts.
   GraphInstance aggregate = instantiate(g, registry);
+  const NodeLabels aggregate_labels = labels_of(g, aggregate);
+  // Sinks that stream their files while runs are merged ask output_directory() on the thread
+  // that merges: every thread of this ensemble answers with this run's --out.
+  const std::string output_dir = opt.output_dir;
 
   // Finished runs wait here until every earlier run has been merged: merging happens strictly
   // in run order (so sums are identical for any thread count) and memory stays bounded by the
@@ -88,18 +147,33 @@ Outcome run_graph(const Graph& g, const PluginRegistry& registry, const RunOptio
   std::map<std::uint64_t, RunRecord> pending;
   std::uint64_t next_merge = 0;
   std::mutex merge_mutex;
+  // A worker does not start a run more than `window` runs ahead of the oldest unmerged one, so a
+  // slow run cannot make finished ones (a sink's rows) pile up without bound.
+  const std::uint64_t window = 4 * static_cast<std::uint64_t>(threads);
+  std::condition_variable merged;
   auto merge_one = [&](std::uint64_t r, RunRecord& rec) {
-    out.source_items += rec.source_items;
-    out.measurements_processed += rec.measurements_processed;
-    for (size_t i = 0; i < N; ++i)
-      if (rec.results[i]) aggregate.components[i]->merge(*rec.results[i]);
+    Activity merging{"merging the results of a run", &aggregate_labels};
+    merging.run = r;
+    merging.has_run = true;
+    ActivityScope scope(merging);
+    try {
+      out.source_items += rec.source_items;
+      out.measurements_processed += rec.measurements_processed;
+      for (size_t i = 0; i < N; ++i)
+        if (rec.results[i]) {
+          detail::executing = aggregate.components[i].get();
+          aggregate.components[i]->merge(*rec.results[i]);
+        }
+    } catch (...) {
+      rethrow_from_plugin();
+    }
     for (const auto& s : rec.diagnostics.skips) {
-      for (auto& n : out.nodes) {
-        if (n.id != s.node) continue;
-        ++n.skips;
-        if (n.skip_examples.size() < 5)
-          n.skip_examples.push_back((runs > 1 ? "run " + std::to_string(r) + ": " : "") + s.message);
-      }
+      const auto it = node_index.find(s.node);
+      if (it == node_index.end()) continue;
+      auto& n = out.nodes[it->second];
+      ++n.skips;
+      if (n.skip_examples.size() < 5)
+        n.skip_examples.push_back((runs > 1 ? "run " + std::to_string(r) + ": " : "") + s.message);
     }
     for (const auto& w : rec.diagnostics.warnings)
       if (out.warnings.size() < 20) out.warnings.push_back(w.node + ": " + w.message);
@@ -112,62 +186,120 @@ Outcome run_graph(const Graph& g, const PluginRegistry& registry, const RunOptio
       pending.erase(it);
       ++next_merge;
     }
+    merged.notify_all();
+  };
+  auto wait_for_window = [&](std::uint64_t run) {
+    std::unique_lock<std::mutex> lock(merge_mutex);
+    merged.wait(lock, [&] { return run < next_merge + window || failed.load(); });
   };
 
   auto worker = [&]() {
+    prepare_thread_for_crash_reports();
+    OutputDirectoryScope dir(output_dir);
     try {
+      Activity building{"building the graph for a worker"};
+      ActivityScope building_scope(building);
       GraphInstance inst = instantiate(g, registry);
+      const NodeLabels labels = labels_of(g, inst);
+      Activity running{"running", &labels};
+      ActivityScope running_scope(running);
       std::vector<Filter*> filters;
       for (auto& c : inst.components)
         if (auto* f = dynamic_cast<Filter*>(c.get())) filters.push_back(f);
       for (;;) {
         const std::uint64_t run = next_run.fetch_add(1);
         if (run >= runs || failed.load()) break;
+        wait_for_window(run);
+        if (failed.load()) break;
+        running.run = run;
+        running.has_run = true;
         RunRecord rec;
         try {
           // The engine, not each filter's discipline, puts back what adapters tuned in the previous
           // run on this instance: otherwise results would depend on which thread ran which run.
-          for (Filter* f : filters) f->reset_adapted_state();
-          for (size_t i = 0; i < N; ++i)
+          for (Filter* f : filters) {
+            detail::executing = f;
+            f->reset_adapted_state();
+          }
+          for (size_t i = 0; i < N; ++i) {
+            detail::executing = inst.components[i].get();
             inst.components[i]->start_run({run, derive_seed(opt.seed, run, g.nodes[i].config.id), &rec.diagnostics});
+          }
           for (Filter* f : filters) f->take_processed();  // a failed earlier run may have left counts
           rec.source_items = drive(inst);
           for (Filter* f : filters) rec.measurements_processed += f->take_processed();
           rec.results.resize(N);
-          for (size_t i = 0; i < N; ++i) rec.results[i] = inst.components[i]->end_run();
-        } catch (const ConfigError&) {
-          throw;
-        } catch (const std::exception& e) {
-          throw DataError("run " + std::to_string(run) + ": " + e.what());
+          for (size_t i = 0; i < N; ++i) {
+            detail::executing = inst.components[i].get();
+            rec.results[i] = inst.components[i]->end_run();
+          }
+          detail::executing = nullptr;
+        } catch (...) {
+          rethrow_from_plugin();  // names the run, the node and its plugin file
         }
+        running.has_run = false;
         complete(run, std::move(rec));
         done.fetch_add(1);
       }
     } catch (...) {
-      std::lock_guard<std::mutex> lock(error_mutex);
-      if (!error) error = std::current_exception();
-      failed = true;
+      {
+        std::lock_guard<std::mutex> lock(error_mutex);
+        if (!error) error = std::current_exception();
+      }
+      {
+        std::lock_guard<std::mutex> lock(merge_mutex);
+        failed = true;
+      }
+      merged.notify_all();
     }
   };
 
   const auto t0 = std::chrono::steady_clock::now();
-  std::vector<std::thread> pool;
-  for (unsigned t = 0; t < threads; ++t) pool.emplace_back(worker);
-  if (opt.progress) {
-    while (done.load() < runs && !failed.load()) {
-      opt.progress(done.load(), runs);
-      std::this_thread::sleep_for(std::chrono::milliseconds(100));
+  {
+    std::vector<std::thread> pool;
+    Joiner joiner{pool};
+    try {
+      // One thread and nothing to show: the calling thread does the work (a sweep runs many
+      // ensembles side by side; a thread each is enough).
+      if (threads == 1 && !opt.progress)
+        worker();
+      else
+        for (unsigned t = 0; t < threads; ++t) pool.emplace_back(worker);
+    } catch (const std::system_error& e) {
+      // A per-user process limit: go on with the workers that started (results do not depend
+      // on their number), or on this thread if none did.
+      if (out.warnings.size() < 20)
+        out.warnings.push_back("engine: started " + std::to_string(pool.size()) + " of " + std::to_string(threads) +
+                               " worker threads (" + e.what() + "); results are the same with fewer");
+      if (pool.empty()) worker();
     }
-    if (!failed.load()) opt.progress(runs, runs);
+    if (opt.progress && !pool.empty()) {
+      try {
+        while (done.load() < runs && !failed.load()) {
+          opt.progress(done.load(), runs);
+          std::this_thread::sleep_for(std::chrono::milliseconds(100));
+        }
+        if (!failed.load()) opt.progress(runs, runs);
+      } catch (...) {
+        // The progress display is cosmetic; the runs go on.
+      }
+    }
   }
-  for (auto& t : pool) t.join();
   const auto t1 = std::chrono::steady_clock::now();
   if (error) std::rethrow_exception(error);
   out.seconds = std::chrono::duration<double>(t1 - t0).count();
 
-  for (size_t i = 0; i < N; ++i) {
-    FinishContext ctx{g.nodes[i].config.id, opt.output_dir, runs};
-    aggregate.components[i]->finish(out.nodes[i].summary, ctx);
+  OutputDirectoryScope dir(output_dir);
+  Activity finishing{"finishing", &aggregate_labels};
+  ActivityScope scope(finishing);
+  try {
+    for (size_t i = 0; i < N; ++i) {
+      FinishContext ctx{g.nodes[i].config.id, opt.output_dir, runs};
+      detail::executing = aggregate.components[i].get();
+      aggregate.components[i]->finish(out.nodes[i].summary, ctx);
+    }
+  } catch (...) {
+    rethrow_from_plugin();
   }
   return out;
 }

@@ -1,10 +1,14 @@
 // Purpose: graph construction and checks (types, parameters, wiring, cycles) and per-thread instantiation.
 #include <trackflow/host/graph.hpp>
+#include <trackflow/host/guard.hpp>
 #include <trackflow/host/suggest.hpp>
 #include <trackflow/host/validate.hpp>
 
 #include <algorithm>
+#include <functional>
 #include <map>
+#include <new>
+#include <queue>
 
 namespace trackflow::host {
 namespace {
@@ -20,7 +24,7 @@ std::string kinds(ItemMask m) {
 
 std::string unknown_type_message(const std::string& type, const PluginRegistry& reg) {
   const auto names = reg.type_names();
-  std::string m = "unknown type '" + type + "'" + did_you_mean(type, names) + ". Available: " +
+  std::string m = "unknown type '" + quote_token(type) + "'" + did_you_mean(type, names) + ". Available: " +
                   (names.empty() ? "none" : join(names)) + ". Searched: " + join(reg.searched());
   for (const auto& p : reg.problems()) m += "\n  plugin not loaded: " + p.str();
   return m;
@@ -35,31 +39,41 @@ Graph build_graph(PipelineConfig cfg, const PluginRegistry& registry) {
     index[g.config.nodes[i].id] = static_cast<int>(i);
     ids.push_back(g.config.nodes[i].id);
   }
+  bool sites_used = false;
   for (const auto& nc : g.config.nodes) {
     GraphNode n;
     n.config = nc;
     n.type = registry.find(nc.type);
     if (!n.type) throw ConfigError(unknown_type_message(nc.type, registry), nc.type_loc, nc.id);
     const ComponentDecl& d = n.type->decl;
-    // A pipeline-wide on_bad_row applies to every node that declares the parameter.
+    // Pipeline-wide settings (on_bad_row, sites, frame_origin) apply to every node that declares the
+    // parameter and does not set it itself.
     Value params = nc.params;
-    const bool declares_bad_row =
-        std::any_of(d.params.begin(), d.params.end(), [](const ParamSpec& s) { return s.name == "on_bad_row"; });
-    if (declares_bad_row && !params.find("on_bad_row")) {
+    auto declares = [&](const char* name) {
+      return std::any_of(d.params.begin(), d.params.end(), [&](const ParamSpec& s) { return s.name == name; });
+    };
+    auto inject = [&](const char* name, const Value& v, const SourceLoc& key_loc) {
+      if (!declares(name) || params.find(name)) return;
       if (params.kind != Value::Kind::Map) params.kind = Value::Kind::Map;
-      Value v;
-      v.kind = Value::Kind::Scalar;
-      v.scalar = g.config.on_bad_row;
-      v.loc = params.loc;
-      params.entries.emplace_back("on_bad_row", v);
-      params.key_locs.push_back(params.loc);
+      params.entries.emplace_back(name, v);
+      params.key_locs.push_back(key_loc);
+    };
+    Value bad_row;
+    bad_row.kind = Value::Kind::Scalar;
+    bad_row.scalar = g.config.on_bad_row;
+    bad_row.loc = params.loc;
+    inject("on_bad_row", bad_row, params.loc);
+    if (g.config.sites.kind == Value::Kind::List) {
+      sites_used |= declares("sites");
+      inject("sites", g.config.sites, g.config.sites.loc);
     }
+    if (g.config.frame_origin.is_scalar()) inject("frame_origin", g.config.frame_origin, g.config.frame_origin.loc);
     n.params = validate_params(d.params, params, nc.id, nc.loc);
     for (size_t k = 0; k < nc.inputs.size(); ++k) {
       const auto& in = nc.inputs[k];
       auto it = index.find(in);
       if (it == index.end())
-        throw ConfigError("input '" + in + "' is not a node" + did_you_mean(in, ids) + "; nodes: " + join(ids),
+        throw ConfigError("input '" + quote_token(in) + "' is not a node" + did_you_mean(in, ids) + "; nodes: " + join_some(ids),
                           nc.input_locs[k], nc.id);
       if (in == nc.id) throw ConfigError("node takes its own output as input (a cycle)", nc.input_locs[k], nc.id);
       n.inputs.push_back(it->second);
@@ -78,11 +92,16 @@ Graph build_graph(PipelineConfig cfg, const PluginRegistry& registry) {
       if (nc.attach_to.empty())
         throw ConfigError("adapter needs 'attach_to: <filter id>' naming the filter it retunes", nc.loc, nc.id);
     } else if (!nc.attach_to.empty()) {
-      throw ConfigError("'attach_to' is only for adapters; " + nc.type + " is a " + to_string(d.kind), nc.attach_loc,
+      throw ConfigError("'attach_to' is only for adapters; " + quote_token(nc.type) + " is a " + to_string(d.kind), nc.attach_loc,
                         nc.id);
     }
     g.nodes.push_back(std::move(n));
   }
+
+  if (g.config.sites.kind == Value::Kind::List && !sites_used)
+    throw ConfigError("'sites' is given but no node takes sites (e.g. sim.trajectory with earth: wgs84, sim.radar "
+                      "with a site); remove it",
+                      g.config.sites.loc);
 
   // Wiring: each input must deliver something this node accepts.
   for (auto& n : g.nodes) {
@@ -100,7 +119,7 @@ Graph build_graph(PipelineConfig cfg, const PluginRegistry& registry) {
     if (!n.config.attach_to.empty()) {
       auto it = index.find(n.config.attach_to);
       if (it == index.end())
-        throw ConfigError("attach_to '" + n.config.attach_to + "' is not a node" + did_you_mean(n.config.attach_to, ids),
+        throw ConfigError("attach_to '" + quote_token(n.config.attach_to) + "' is not a node" + did_you_mean(n.config.attach_to, ids),
                           n.config.attach_loc, n.config.id);
       if (g.nodes[it->second].type->decl.kind != ComponentKind::Filter)
         throw ConfigError("attach_to '" + n.config.attach_to + "' is a " +
@@ -110,21 +129,46 @@ Graph build_graph(PipelineConfig cfg, const PluginRegistry& registry) {
     }
   }
 
-  // Kahn's algorithm; whatever is left over lies on a cycle.
+  // Kahn's algorithm over consumer lists (linear in nodes + wires), taking ready nodes in
+  // declaration order as before; whatever is left over lies on a cycle.
   const int N = static_cast<int>(g.nodes.size());
   std::vector<int> pending(N);
-  for (int i = 0; i < N; ++i) pending[i] = static_cast<int>(g.nodes[i].inputs.size());
+  std::vector<std::vector<int>> consumers(N);
+  for (int i = 0; i < N; ++i) {
+    pending[i] = static_cast<int>(g.nodes[i].inputs.size());
+    for (int in : g.nodes[i].inputs) consumers[in].push_back(i);
+  }
   std::vector<bool> done(N, false);
-  for (bool progress = true; progress;) {
-    progress = false;
-    for (int i = 0; i < N; ++i) {
-      if (done[i] || pending[i] != 0) continue;
-      done[i] = true;
-      progress = true;
-      g.order.push_back(i);
-      for (int j = 0; j < N; ++j)
-        for (int in : g.nodes[j].inputs)
-          if (in == i) --pending[j];
+  {
+    // The order the former quadratic sweep produced: repeated passes over the nodes in declaration
+    // order, each taking every node whose inputs are all done. A node freed by a node later in
+    // the same pass is taken in that pass when it comes after it, else in the next pass.
+    std::vector<int> current, next;
+    for (int i = 0; i < N; ++i)
+      if (pending[i] == 0) current.push_back(i);
+    std::vector<char> queued(N, 0);
+    for (int i : current) queued[i] = 1;
+    while (!current.empty()) {
+      // `current` is sorted; nodes freed during this pass at a higher index than the node being
+      // processed join this pass, the others wait for the next.
+      std::priority_queue<int, std::vector<int>, std::greater<int>> pass(current.begin(), current.end());
+      next.clear();
+      while (!pass.empty()) {
+        const int i = pass.top();
+        pass.pop();
+        done[i] = true;
+        g.order.push_back(i);
+        for (int j : consumers[i]) {
+          if (--pending[j] != 0 || queued[j]) continue;
+          queued[j] = 1;
+          if (j > i)
+            pass.push(j);
+          else
+            next.push_back(j);
+        }
+      }
+      std::sort(next.begin(), next.end());
+      current.swap(next);
     }
   }
   if (static_cast<int>(g.order.size()) != N) {
@@ -151,6 +195,16 @@ Graph build_graph(PipelineConfig cfg, const PluginRegistry& registry) {
                       first.config.loc, first.config.id);
   }
 
+  // What `run` would refuse only after all the runs, `validate` refuses now: an expect naming a
+  // node that does not exist (metric names are known only once the nodes have reported).
+  for (const auto& e : g.config.expects)
+    for (const std::string* id : {&e.node, &e.ref_node}) {
+      if (id->empty() || index.count(*id)) continue;
+      throw ConfigError("expect names node '" + quote_token(*id) + "', which does not exist" + did_you_mean(*id, ids) +
+                            "; nodes: " + join_some(ids),
+                        e.loc);
+    }
+
   // Plugin-side checks (segment consistency, data files) run at construction.
   (void)instantiate(g, registry);
   return g;
@@ -165,10 +219,12 @@ std::string frames(FrameMask m) {
   return f.empty() ? "no" : join(f, "/");
 }
 
+// The converters that turn measurements into Cartesian ones (not, e.g., a spherical corrector).
 std::vector<std::string> converter_types(const PluginRegistry& registry) {
   std::vector<std::string> out;
   for (const auto& t : registry.types())
-    if (t.decl.kind == ComponentKind::Converter) out.push_back(t.decl.type);
+    if (t.decl.kind == ComponentKind::Converter && (t.decl.produces_frames & mask(Frame::Cartesian)))
+      out.push_back(t.decl.type);
   std::sort(out.begin(), out.end());
   return out;
 }
@@ -202,20 +258,49 @@ std::string qualified(const std::string& adapter, const std::vector<std::string>
 
 }  // namespace
 
+GraphInstance instantiate_checked(const Graph& g, const PluginRegistry& registry);
+
+// Whatever else escapes plugin code while the graph is wired (needs(), noise(), frames) is a bug.
 GraphInstance instantiate(const Graph& g, const PluginRegistry& registry) {
+  try {
+    return instantiate_checked(g, registry);
+  } catch (const ConfigError&) {
+    throw;
+  } catch (const InternalError&) {
+    throw;
+  } catch (const std::bad_alloc&) {
+    throw;
+  } catch (const std::exception& e) {
+    throw InternalError(std::string("a plugin threw while the graph was wired: ") + e.what() + " (a bug in that plugin)");
+  } catch (...) {
+    throw InternalError("a plugin threw an exception that is not a std::exception while the graph was wired");
+  }
+}
+
+GraphInstance instantiate_checked(const Graph& g, const PluginRegistry& registry) {
   GraphInstance inst;
   const size_t N = g.nodes.size();
   inst.components.resize(N);
   inst.links.resize(N);
   for (size_t i = 0; i < N; ++i) {
     const GraphNode& n = g.nodes[i];
+    const std::string label = "node '" + n.config.id + "' (" + n.config.type + " from " + n.type->file + ")";
+    Activity constructing{"constructing", nullptr, &label};
+    ActivityScope scope(constructing);
     try {
       inst.components[i] = registry.create(*n.type, n.params);
     } catch (const ConfigError& e) {
       if (!e.node().empty()) throw;
       throw ConfigError(e.what(), e.where().line ? e.where() : n.config.loc, n.config.id);
-    } catch (const std::exception& e) {
+    } catch (const DataError& e) {
       throw ConfigError(e.what(), n.config.loc, n.config.id);
+    } catch (const std::bad_alloc&) {
+      throw;  // out of memory is no mistake in the pipeline
+    } catch (const std::exception& e) {
+      // What a factory throws is most often a refusal of its parameters; it is reported with the node.
+      throw ConfigError(e.what(), n.config.loc, n.config.id);
+    } catch (...) {
+      throw InternalError("constructing " + label + " threw an exception that is not a std::exception (a bug in that plugin)");
     }
   }
   check_frames(g, inst, registry);
@@ -256,6 +341,12 @@ GraphInstance instantiate(const Graph& g, const PluginRegistry& registry) {
       inst.components[i]->set_inputs(infos);
     } catch (const ConfigError& e) {
       throw ConfigError(e.what(), e.where().line ? e.where() : n.config.loc, n.config.id);
+    } catch (const std::exception& e) {
+      throw InternalError("node '" + n.config.id + "' (" + n.config.type + " from " + n.type->file +
+                          ") threw in set_inputs: " + e.what() + " (a bug in that plugin)");
+    } catch (...) {
+      throw InternalError("node '" + n.config.id + "' (" + n.config.type + " from " + n.type->file +
+                          ") threw an exception that is not a std::exception in set_inputs (a bug in that plugin)");
     }
     for (size_t k = 0; k < n.inputs.size(); ++k)
       inst.links[n.inputs[k]].push_back({inst.components[i].get(), static_cast<int>(k), n.input_kinds[k]});

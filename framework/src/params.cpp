@@ -58,6 +58,13 @@ ParamSpec ParamSpec::records(std::string name, std::vector<ParamSpec> fields, st
   return s;
 }
 
+ParamValue::ParamValue() = default;
+ParamValue::ParamValue(const ParamValue&) = default;
+ParamValue::ParamValue(ParamValue&&) noexcept = default;
+ParamValue& ParamValue::operator=(const ParamValue&) = default;
+ParamValue& ParamValue::operator=(ParamValue&&) noexcept = default;
+ParamValue::~ParamValue() = default;
+
 const ParamValue& Params::get(std::string_view name, ParamType expected) const {
   for (const auto& [n, v] : values_) {
     if (n != name) continue;

@@ -1,4 +1,5 @@
 // Purpose: plugin discovery and loading with Boost.DLL, with a staged, file-naming error for each failure.
+#include <trackflow/host/guard.hpp>
 #include <trackflow/host/plugins.hpp>
 #include <trackflow/plugin.hpp>
 
@@ -47,26 +48,46 @@ void keep_loaded(std::shared_ptr<boost::dll::shared_library> lib) {
 
 }  // namespace
 
-void PluginRegistry::load_directories(const std::vector<std::string>& dirs) {
+void PluginRegistry::load_directories(const std::vector<std::string>& dirs, bool builtin) {
   for (const auto& d : dirs) {
     searched_.push_back(d);
     std::error_code ec;
     if (!fs::is_directory(d, ec)) continue;
     std::vector<fs::path> files;
-    for (const auto& e : fs::directory_iterator(d, ec)) {
-      const auto name = e.path().filename().string();
-      if (name.rfind("tfplugin_", 0) == 0 && e.path().extension() == ".so") files.push_back(e.path());
+    // Incremented with an error code: an unreadable entry ends the listing, it does not throw.
+    for (fs::directory_iterator it(d, ec), end; !ec && it != end; it.increment(ec)) {
+      const fs::path& p = it->path();
+      const auto name = p.filename().string();
+      if (name.rfind("tfplugin_", 0) == 0 && p.extension() == ".so") files.push_back(p);
     }
     std::sort(files.begin(), files.end());  // directory order is arbitrary; loading order must not be
-    for (const auto& f : files) load_file(f.string());
+    for (const auto& f : files) load_file(f.string(), builtin);
   }
 }
 
-void PluginRegistry::load_file(const std::string& path) {
-  for (const auto& p : plugins_)
-    if (fs::equivalent(p.file, path)) return;
-  auto lib = std::make_shared<boost::dll::shared_library>();
+void PluginRegistry::allow_replacing(std::vector<std::string> types) { replaceable_ = std::move(types); }
+
+void PluginRegistry::load_file(const std::string& path, bool builtin) {
   std::error_code ec;
+  // A looping or dangling symlink, a FIFO or a folder named tfplugin_*.so is a problem of that
+  // file, not of the command (and opening a FIFO would block).
+  const fs::file_status st = fs::status(path, ec);
+  if (ec) {
+    problems_.push_back({path, "open", "cannot resolve the file: " + ec.message()});
+    return;
+  }
+  if (!fs::is_regular_file(st)) {
+    problems_.push_back({path, "open", "not a regular file"});
+    return;
+  }
+  for (const auto& p : plugins_) {
+    std::error_code eq;
+    if (fs::equivalent(p.file, path, eq) && !eq) return;
+  }
+  const std::string loading = path;
+  Activity activity{"loading plugin", nullptr, &loading};
+  ActivityScope scope(activity);  // a crash in the plugin's static constructors names the file
+  auto lib = std::make_shared<boost::dll::shared_library>();
   lib->load(path, boost::dll::load_mode::rtld_lazy | boost::dll::load_mode::rtld_local, ec);
   if (ec) {
     // Boost's error text is errno's, which is misleading here; dlerror() says what went wrong.
@@ -102,19 +123,36 @@ void PluginRegistry::load_file(const std::string& path) {
   } catch (const std::exception& e) {
     problems_.push_back({path, "register", std::string("registration threw: ") + e.what()});
     return;
+  } catch (...) {
+    problems_.push_back({path, "register", "registration threw an exception that is not a std::exception"});
+    return;
   }
   LoadedPlugin loaded{path, info->plugin_name ? info->plugin_name : "", {}};
   for (auto& d : reg.decls) {
-    if (const RegisteredType* prev = find(d.type)) {
-      problems_.push_back({path, "register", "type '" + d.type + "' already provided by " + prev->file + " (kept that one)"});
-      continue;
-    }
     if (!d.create) {
       problems_.push_back({path, "register", "type '" + d.type + "' has no factory"});
       continue;
     }
+    if (const RegisteredType* prev = find(d.type)) {
+      // A built-in type is replaced only when the user names it (--replace-type): a plugin folder
+      // must not silently change what `filter.kalman` means.
+      const bool asked = std::find(replaceable_.begin(), replaceable_.end(), d.type) != replaceable_.end();
+      if (!prev->builtin || builtin || !asked) {
+        problems_.push_back({path, "register",
+                             "type '" + d.type + "' already provided by " + prev->file + " (kept that one" +
+                                 (prev->builtin && !builtin ? "; it is built in: pass --replace-type " + d.type +
+                                                                  " to use this plugin's instead"
+                                                            : std::string()) +
+                                 ")"});
+        continue;
+      }
+      const std::string prev_file = prev->file;
+      for (auto& p : plugins_)
+        if (p.file == prev_file) p.types.erase(std::remove(p.types.begin(), p.types.end(), d.type), p.types.end());
+      types_.erase(types_.begin() + (prev - types_.data()));
+    }
     loaded.types.push_back(d.type);
-    types_.push_back({lib, std::move(d), path});
+    types_.push_back({lib, std::move(d), path, builtin});
   }
   plugins_.push_back(std::move(loaded));
 }
@@ -139,7 +177,7 @@ std::shared_ptr<Component> PluginRegistry::create(const RegisteredType& t, const
   return std::shared_ptr<Component>(c.release(), [lib](Component* ptr) { delete ptr; });
 }
 
-std::vector<std::string> default_plugin_dirs() {
+std::vector<std::string> environment_plugin_dirs() {
   std::vector<std::string> dirs;
   if (const char* env = std::getenv("TRACKFLOW_PLUGIN_PATH")) {
     std::string s = env;
@@ -152,6 +190,11 @@ std::vector<std::string> default_plugin_dirs() {
       pos = c + 1;
     }
   }
+  return dirs;
+}
+
+std::vector<std::string> builtin_plugin_dirs() {
+  std::vector<std::string> dirs;
   std::error_code ec;
   const fs::path exe = fs::read_symlink("/proc/self/exe", ec);
   if (!ec) {
@@ -162,6 +205,12 @@ std::vector<std::string> default_plugin_dirs() {
     const fs::path installed = (prefix / TRACKFLOW_INSTALL_PLUGIN_RELDIR).lexically_normal();
     if (installed.string() != dirs.back()) dirs.push_back(installed.string());
   }
+  return dirs;
+}
+
+std::vector<std::string> default_plugin_dirs() {
+  std::vector<std::string> dirs = environment_plugin_dirs();
+  for (auto& d : builtin_plugin_dirs()) dirs.push_back(std::move(d));
   return dirs;
 }
 

@@ -4,7 +4,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cerrno>
 #include <cmath>
+#include <cstring>
 #include <cstdio>
 #include <filesystem>
 #include <fstream>
@@ -178,10 +180,14 @@ void write_metrics_json(const std::string& path, const Outcome& out) {
     if (n.skips > 0) node["skipped"] = {{"value", n.skips}, {"unit", ""}};
     j[n.id] = std::move(node);
   }
-  std::ofstream f(path);
-  if (!f) throw ConfigError("cannot write metrics JSON '" + path + "'");
-  f << j.dump(2) << "\n";
-  if (!f) throw ConfigError("error writing metrics JSON '" + path + "'");
+  // Node ids are ASCII, but metric names come from plugins: invalid UTF-8 becomes U+FFFD rather
+  // than an exception or an invalid file.
+  const std::string text = j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
+  std::ofstream f(path, std::ios::binary | std::ios::trunc);
+  if (!f) throw ConfigError("cannot write metrics JSON '" + path + "': " + std::strerror(errno));
+  f << text;
+  f.close();  // a full disk shows at the flush
+  if (f.fail()) throw ConfigError("error writing metrics JSON '" + path + "': " + std::strerror(errno));
 }
 
 }  // namespace trackflow::host

@@ -20,9 +20,12 @@ std::size_t edit_distance(const std::string& a, const std::string& b) {
 }
 
 std::string did_you_mean(const std::string& word, const std::vector<std::string>& candidates) {
+  // Edit distance is quadratic in the lengths: a long word is not a typo of a name.
+  if (word.size() > 64) return {};
   std::string best;
   std::size_t best_d = std::string::npos;
   for (const auto& c : candidates) {
+    if (c.size() > 64) continue;
     const std::size_t d = edit_distance(word, c);
     if (d < best_d) {
       best_d = d;
@@ -32,12 +35,50 @@ std::string did_you_mean(const std::string& word, const std::vector<std::string>
   // Close enough to be a typo: a third of the word, at least 2 edits.
   const std::size_t limit = std::max<std::size_t>(2, word.size() / 3);
   if (best.empty() || best_d > limit) return {};
-  return " (did you mean '" + best + "'?)";
+  return " (did you mean '" + quote_token(best) + "'?)";
 }
 
 std::string join(const std::vector<std::string>& words, const std::string& sep) {
   std::string s;
   for (const auto& w : words) s += (s.empty() ? "" : sep) + w;
+  return s;
+}
+
+}  // namespace trackflow::host
+
+namespace trackflow::host {
+
+std::string join_some(const std::vector<std::string>& words, std::size_t max) {
+  if (words.size() <= max) return join(words);
+  std::vector<std::string> head(words.begin(), words.begin() + static_cast<std::ptrdiff_t>(max));
+  return join(head) + ", ... (" + std::to_string(words.size() - max) + " more)";
+}
+
+std::string quote_token(std::string_view word, std::size_t max) {
+  std::string s;
+  const std::size_t n = std::min(word.size(), max);
+  s.reserve(n + 3);
+  for (std::size_t i = 0; i < n;) {
+    const unsigned char c = static_cast<unsigned char>(word[i]);
+    if (c < 0x80) {
+      s += c < 0x20 || c == 0x7f ? '?' : static_cast<char>(c);
+      ++i;
+      continue;
+    }
+    // A whole, valid UTF-8 sequence is kept; any other byte becomes '?' (the message stays
+    // valid UTF-8 for terminals and JSON).
+    const std::size_t len = c >= 0xF0 && c <= 0xF4 ? 4 : c >= 0xE0 ? 3 : c >= 0xC2 && c <= 0xDF ? 2 : 0;
+    bool ok = len > 0 && len <= 4 && i + len <= n;
+    for (std::size_t k = 1; ok && k < len; ++k) ok = (static_cast<unsigned char>(word[i + k]) & 0xC0) == 0x80;
+    if (ok) {
+      s.append(word.substr(i, len));
+      i += len;
+    } else {
+      s += '?';
+      ++i;
+    }
+  }
+  if (word.size() > max) s += "...";
   return s;
 }
 

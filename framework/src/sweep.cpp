@@ -1,4 +1,5 @@
 // Purpose: parsing of sweep axes and enumeration of the grid.
+#include <trackflow/host/suggest.hpp>
 #include <trackflow/host/sweep.hpp>
 
 namespace trackflow::host {
@@ -22,13 +23,20 @@ SweepAxis parse_sweep_axis(const std::string& text) {
   for (auto& v : a.values) {
     const auto b = v.find_first_not_of(' '), e = v.find_last_not_of(' ');
     v = b == std::string::npos ? std::string() : v.substr(b, e - b + 1);
-    if (v.empty()) throw ConfigError("--param '" + text + "': empty value in the list");
+    if (v.empty()) throw ConfigError("--param '" + quote_token(text) + "': empty value in the list");
   }
-  if (depth != 0) throw ConfigError("--param '" + text + "': unbalanced brackets");
+  if (depth != 0) throw ConfigError("--param '" + quote_token(text) + "': unbalanced brackets");
   return a;
 }
 
 std::vector<std::vector<Override>> sweep_grid(const std::vector<SweepAxis>& axes) {
+  std::size_t points = 1;
+  for (const auto& a : axes) {
+    if (a.values.size() > kMaxSweepPoints || points * a.values.size() > kMaxSweepPoints)
+      throw ConfigError("the sweep grid has more than " + std::to_string(kMaxSweepPoints) +
+                        " points (the product of the --param list lengths); split it into several sweeps");
+    points *= a.values.size();
+  }
   std::vector<std::vector<Override>> grid(1);
   for (const auto& a : axes) {
     std::vector<std::vector<Override>> next;

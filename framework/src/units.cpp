@@ -36,20 +36,38 @@ std::string trim(std::string_view s) {
   return std::string(s.substr(a, b - a));
 }
 
+// Powers beyond this are typing mistakes or attacks (m2147483647 would overflow the exponents).
+constexpr int kMaxPower = 12;
+constexpr int kMaxExponent = 24;
+
+// A unit's word as quoted in a message: short, no control characters.
+std::string token(std::string_view s) {
+  std::string t;
+  for (size_t i = 0; i < s.size() && i < 40; ++i) {
+    const unsigned char c = static_cast<unsigned char>(s[i]);
+    t += c < 0x20 || c == 0x7f ? '?' : static_cast<char>(c);
+  }
+  return s.size() > 40 ? t + "..." : t;
+}
+
 // One factor such as "m", "s2", "s^3", "km".
 Unit parse_factor(const std::string& f) {
   size_t end = f.size();
   while (end > 0 && std::isdigit(static_cast<unsigned char>(f[end - 1]))) --end;
   std::string name = f.substr(0, end);
   int power = 1;
-  if (end < f.size()) power = std::stoi(f.substr(end));
+  if (end < f.size()) {
+    const auto [ptr, ec] = std::from_chars(f.data() + end, f.data() + f.size(), power);
+    if (ec != std::errc() || ptr != f.data() + f.size() || power > kMaxPower)
+      throw std::invalid_argument("power of '" + token(f) + "' is too large (at most " + std::to_string(kMaxPower) + ")");
+  }
   if (!name.empty() && name.back() == '^') name.pop_back();
   for (const auto& u : kUnits) {
     if (name == u.name) return {std::pow(u.scale, power), u.dimension.pow(power)};
   }
   std::string known;
   for (const auto& u : kUnits) known += std::string(known.empty() ? "" : " ") + u.name;
-  throw std::invalid_argument("unknown unit '" + f + "' (known: " + known + ", combined with / and powers, e.g. m/s2)");
+  throw std::invalid_argument("unknown unit '" + token(f) + "' (known: " + known + ", combined with / and powers, e.g. m/s2)");
 }
 
 }  // namespace
@@ -81,7 +99,7 @@ Unit parse_unit(std::string_view text) {
   while (pos <= s.size()) {
     size_t next = s.find_first_of("/*", pos);
     std::string factor = trim(s.substr(pos, next == std::string::npos ? std::string::npos : next - pos));
-    if (factor.empty()) throw std::invalid_argument("malformed unit '" + s + "'");
+    if (factor.empty()) throw std::invalid_argument("malformed unit '" + token(s) + "'");
     if (factor != "1") {
       Unit u = parse_factor(factor);
       if (divide) {
@@ -91,6 +109,12 @@ Unit parse_unit(std::string_view text) {
         result.scale *= u.scale;
         result.dimension = result.dimension * u.dimension;
       }
+      const Dimension& d = result.dimension;
+      for (int e : {d.length, d.time, d.angle, d.decibel})
+        if (e > kMaxExponent || e < -kMaxExponent)
+          throw std::invalid_argument("unit '" + token(s) + "' has a power beyond " + std::to_string(kMaxExponent));
+      if (!std::isfinite(result.scale) || result.scale == 0.0)
+        throw std::invalid_argument("unit '" + token(s) + "' overflows a double");
     }
     if (next == std::string::npos) break;
     divide = s[next] == '/';
@@ -103,15 +127,14 @@ Quantity parse_quantity(std::string_view text) {
   const std::string s = trim(text);
   if (s.empty()) throw std::invalid_argument("empty value");
   double v = 0.0;
-  const char* first = s.data();
+  // from_chars rejects a leading '+': skip one (only one: "++1" stays an error).
+  const char* first = s.data() + (s.size() > 1 && s[0] == '+' && s[1] != '-' && s[1] != '+' ? 1 : 0);
   const char* last = s.data() + s.size();
   auto [ptr, ec] = std::from_chars(first, last, v);
   if (ec != std::errc()) {
-    // from_chars rejects a leading '+'
-    if (s[0] == '+') return parse_quantity(s.substr(1));
-    throw std::invalid_argument("'" + s + "' is not a number");
+    throw std::invalid_argument("'" + token(s) + "' is not a number");
   }
-  if (!std::isfinite(v)) throw std::invalid_argument("'" + s + "' is not a finite number");
+  if (!std::isfinite(v)) throw std::invalid_argument("'" + token(s) + "' is not a finite number");
   Quantity q;
   const std::string rest = trim(std::string_view(ptr, static_cast<size_t>(last - ptr)));
   if (rest.empty()) {
@@ -120,6 +143,9 @@ Quantity parse_quantity(std::string_view text) {
   }
   const Unit u = parse_unit(rest);
   q.value = v * u.scale;
+  // Finite before and after the unit: "1e308 km" is infinite in SI.
+  if (!std::isfinite(q.value))
+    throw std::invalid_argument("'" + token(s) + "' is not a finite number in SI (" + token(rest) + " overflows it)");
   q.dimension = u.dimension;
   q.had_unit = true;
   return q;

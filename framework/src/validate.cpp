@@ -26,7 +26,7 @@ double parse_real(const ParamSpec& s, const Value& v, const std::string& node) {
     throw ConfigError("parameter '" + s.name + "': " + e.what(), v.loc, node);
   }
   if (q.had_unit && q.dimension != s.dimension)
-    throw ConfigError("parameter '" + s.name + "' has unit dimension " + s.dimension.str() + ", but '" + v.scalar +
+    throw ConfigError("parameter '" + s.name + "' has unit dimension " + s.dimension.str() + ", but '" + quote_token(v.scalar) +
                           "' is " + q.dimension.str(),
                       v.loc, node);
   if (q.value < s.min || q.value > s.max) {
@@ -37,7 +37,7 @@ double parse_real(const ParamSpec& s, const Value& v, const std::string& node) {
       range = s.min > 0 && s.min < 1e-300 ? std::string("positive") : "at least " + fmt_si(s.min);
     else
       range = "at most " + fmt_si(s.max);
-    throw ConfigError("parameter '" + s.name + "' must be " + range + " " + s.dimension.str() + ", got '" + v.scalar +
+    throw ConfigError("parameter '" + s.name + "' must be " + range + " " + s.dimension.str() + ", got '" + quote_token(v.scalar) +
                           "'",
                       v.loc, node);
   }
@@ -85,7 +85,7 @@ ParamValue parse_value(const ParamSpec& s, const Value& v, const std::string& no
       if (!v.is_scalar()) throw type_error();
       const auto it = std::find(s.choices.begin(), s.choices.end(), v.scalar);
       if (it == s.choices.end())
-        throw ConfigError("parameter '" + s.name + "' must be one of " + join(s.choices, ", ") + "; got '" + v.scalar +
+        throw ConfigError("parameter '" + s.name + "' must be one of " + join(s.choices, ", ") + "; got '" + quote_token(v.scalar) +
                               "'" + did_you_mean(v.scalar, s.choices),
                           v.loc, node);
       const size_t i = static_cast<size_t>(it - s.choices.begin());
@@ -138,7 +138,7 @@ Params validate_params(const std::vector<ParamSpec>& specs, const Value& given, 
   for (size_t i = 0; i < given.entries.size(); ++i) {
     const auto& key = given.entries[i].first;
     if (std::find(names.begin(), names.end(), key) == names.end())
-      throw ConfigError("unknown parameter '" + key + "'" + did_you_mean(key, names) +
+      throw ConfigError("unknown parameter '" + quote_token(key) + "'" + did_you_mean(key, names) +
                             (names.empty() ? "; this type takes no parameters" : "; known: " + join(names)),
                         given.key_locs[i], node);
   }

@@ -92,6 +92,26 @@ expect_run "describe an unknown type" 2 "did you mean 'sim.radar'" -- "$TF" desc
 expect_run "run --help documents exit codes and options" 0 "--threads" -- "$TF" run --help
 expect_run "top-level help lists commands and exit codes" 0 "Exit codes: 0 ok, 1 an .expect. check failed, 2 bad" -- "$TF" --help
 
+# Geodetic sites: written once at the top level, handed to the nodes that declare them; their
+# field errors point at the sites: lines and name the node that read them.
+geo() {
+  printf 'pipeline: { name: geo, seed: 1, runs: 1, frame_origin: %s }\n' "$1"
+  printf 'sites:\n  naro: { latitude: 34.43 deg, longitude: 127.53 deg }\n  jeju: { latitude: %s, longitude: 126.46 deg }\n' "$2"
+  printf 'nodes:\n  - id: truth\n    type: sim.trajectory\n    params: { profile: kslv1, earth: wgs84, pad_site: naro, launch_azimuth: 170 deg, profile_duration: 2 s }\n'
+  printf '  - id: radar\n    type: sim.radar\n    input: truth\n    params: { site: jeju }\n'
+}
+geo jeju "33.28 deg" > "$TMP/geo_ok.yaml"
+expect_run "geodetic sites validate" 0 "ok" -- "$TF" validate "$TMP/geo_ok.yaml"
+geo jej "33.28 deg" > "$TMP/geo_origin.yaml"
+expect_run "frame_origin names no site" 2 "geo_origin.yaml:1:56: frame_origin 'jej' is not a site \(did you mean 'jeju'\?\); sites: naro, jeju" \
+  -- "$TF" validate "$TMP/geo_origin.yaml"
+geo jeju "33.28 m" > "$TMP/geo_unit.yaml"
+expect_run "a site field with the wrong unit" 2 "geo_unit.yaml:4:21: node 'truth': parameter 'latitude' has unit dimension rad" \
+  -- "$TF" validate "$TMP/geo_unit.yaml"
+{ base | sed 's/^pipeline: .*$/pipeline: { name: errors, seed: 1, runs: 1 }\nsites: { naro: { latitude: 34.43 deg, longitude: 127.53 deg } }/'; } > "$TMP/geo_unused.yaml"
+expect_run "sites without frame_origin" 2 "geo_unused.yaml:2:8: 'sites' needs 'frame_origin: <site>'" \
+  -- "$TF" validate "$TMP/geo_unused.yaml"
+
 printf 'expect:\n  score.position_rmse: { max: 0.001 }\n' > "$TMP/fail_tail.yaml"
 { base; cat "$TMP/fail_tail.yaml"; } > "$TMP/expect_fail.yaml"
 expect_run "a failed expect exits 1" 1 "FAIL  score.position_rmse" -- "$TF" run "$TMP/expect_fail.yaml" --out "$TMP/out"

@@ -62,6 +62,8 @@ const Case kCases[] = {
     {"worst_noise", "pipelines/worst_noise.yaml", 1, 10, 500},
     {"rbs_landing_scn1", "pipelines/rbs_landing_scn1.yaml", 2, 10, 60},  // 1336 -> 32
     {"rbs_landing_scn3", "pipelines/rbs_landing_scn3.yaml", 2, 10, 60},
+    {"monopulse_glint", "pipelines/monopulse_glint_ekf_vs_aekf.yaml", 1, 10, 250},        // filter.ekf + adapt.range_r
+    {"refraction_bias_estimation", "pipelines/refraction_bias_estimation.yaml", 1, 10, 100},  // filter.refraction_ekf
     {"variants", "tests/reference/variants.yaml", 1, 10, 10},
 };
 

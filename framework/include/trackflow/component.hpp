@@ -17,6 +17,22 @@ namespace trackflow {
 
 class Component;
 
+namespace detail {
+// The component this thread is executing: set around every delivery (Outputs::emit, adapter
+// hooks) and by the engine around its own calls, so that when a plugin throws or crashes the
+// host can name the node. Two stores per delivery; initial-exec TLS (libtrackflow is always
+// loaded with the program), so no call.
+extern BOOST_SYMBOL_VISIBLE thread_local constinit Component* executing
+#if defined(__GNUC__)
+    __attribute__((tls_model("initial-exec")))
+#endif
+    ;
+}  // namespace detail
+
+// The folder (--out) the ensemble this thread works for writes into, for a sink that streams
+// its file while runs are merged (merge() has no FinishContext); empty outside the engine.
+BOOST_SYMBOL_VISIBLE const std::string& output_directory();
+
 // One downstream connection: deliver to `target` on its input port `port`.
 struct Link {
   Component* target = nullptr;
@@ -222,7 +238,11 @@ class BOOST_SYMBOL_VISIBLE Filter : public Component {
  protected:
   static constexpr double kNoAnnotation = std::numeric_limits<double>::quiet_NaN();
   void before_update(const Measurement& m) {
-    for (int i = 0; i < adapter_count_; ++i) adapters_[i]->before_update(m, *this);
+    for (int i = 0; i < adapter_count_; ++i) {
+      detail::executing = adapters_[i];
+      adapters_[i]->before_update(m, *this);
+    }
+    detail::executing = this;
   }
   // Whether anything sees the estimates: a consumer downstream or an adapter's after_update.
   bool observed() const { return adapter_count_ > 0 || out.count() > 0; }
@@ -231,7 +251,11 @@ class BOOST_SYMBOL_VISIBLE Filter : public Component {
     e.annotation_count = annotation_count_;
     for (int i = 0; i < annotation_count_; ++i) e.annotations[i] = annotation_values_[i];
     ++processed_;
-    for (int i = 0; i < adapter_count_; ++i) adapters_[i]->after_update(m, e, *this);
+    for (int i = 0; i < adapter_count_; ++i) {
+      detail::executing = adapters_[i];
+      adapters_[i]->after_update(m, e, *this);
+    }
+    detail::executing = this;
     out.emit(e);
   }
 
@@ -249,17 +273,34 @@ class BOOST_SYMBOL_VISIBLE Filter : public Component {
 
 inline void Adapter::annotate(Filter& f, int i, double value) const { f.set_annotation(first_annotation_ + i, value); }
 
+// Each delivery marks its target as executing; if the target throws, the mark stays on the
+// innermost node, which is the one the host names.
 inline void Outputs::emit(const Truth& t) const {
+  Component* const self = detail::executing;
   for (int i = 0; i < count_; ++i)
-    if (links_[i].accepts & mask(ItemKind::Truth)) links_[i].target->on_truth(t, links_[i].port);
+    if (links_[i].accepts & mask(ItemKind::Truth)) {
+      detail::executing = links_[i].target;
+      links_[i].target->on_truth(t, links_[i].port);
+    }
+  detail::executing = self;
 }
 inline void Outputs::emit(const Measurement& m) const {
+  Component* const self = detail::executing;
   for (int i = 0; i < count_; ++i)
-    if (links_[i].accepts & mask(ItemKind::Measurement)) links_[i].target->on_measurement(m, links_[i].port);
+    if (links_[i].accepts & mask(ItemKind::Measurement)) {
+      detail::executing = links_[i].target;
+      links_[i].target->on_measurement(m, links_[i].port);
+    }
+  detail::executing = self;
 }
 inline void Outputs::emit(const Estimate& e) const {
+  Component* const self = detail::executing;
   for (int i = 0; i < count_; ++i)
-    if (links_[i].accepts & mask(ItemKind::Estimate)) links_[i].target->on_estimate(e, links_[i].port);
+    if (links_[i].accepts & mask(ItemKind::Estimate)) {
+      detail::executing = links_[i].target;
+      links_[i].target->on_estimate(e, links_[i].port);
+    }
+  detail::executing = self;
 }
 
 }  // namespace trackflow

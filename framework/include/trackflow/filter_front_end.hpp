@@ -1,4 +1,4 @@
-// Purpose: the one measurement front end every filter uses — validity, frame, well-formedness, time order, range rate, R, adapter hooks, non-finite check, initialise/predict/update/publish — with its counted skips.
+// Purpose: the one measurement front end every filter uses — validity, frame, well-formedness, time order, range rate, R, adapter hooks, non-finite checks (measurement in, state out), initialise/predict/update/publish — with its counted skips.
 #pragma once
 
 #include <trackflow/component.hpp>
@@ -37,6 +37,7 @@ struct FrontEndRunResult final : RunResult {
   std::uint64_t non_finite = 0;  // flagged valid but non-finite (value or R): predicted through
   std::uint64_t rejected = 0;    // the filter refused the update (it said why in a warning)
   std::uint64_t counters[kMaxCounters] = {};
+  std::uint64_t refused_non_finite = 0;  // steps whose state came out non-finite: not published, track restarted
 };
 
 // The template method of every filter (CRTP: no virtual call on the hot path). Derived provides
@@ -54,10 +55,14 @@ struct FrontEndRunResult final : RunResult {
 template <class Derived>
 class FilterFrontEnd : public Filter, public RunResultCodec {
  public:
+  // Two measurements closer than this (seconds) do not start a track by differencing.
+  static constexpr double kMinStartInterval = 1e-6;
+
   void start_run(const RunContext& ctx) final {
     diag_ = ctx.diagnostics;
     has_time_ = false;
     non_finite_reported_ = false;
+    refusal_reported_ = false;
     run_ = FrontEndRunResult{};
     clear_innovation();
     initialised_ = derived().reset_track();
@@ -97,7 +102,10 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
     time_ = m.time;
     has_time_ = true;
     if (!initialised_) {
-      if (usable && derived().initialise(m, dim)) {
+      // Differencing two points closer than kMinStartInterval divides by ~0 (1e-170 s apart
+      // gives infinities): the later point starts the track afresh instead.
+      if (usable && had_time && T > 0.0 && T < kMinStartInterval) initialised_ = derived().reset_track();
+      if (!initialised_ && usable && derived().initialise(m, dim)) {
         initialised_ = true;
         clear_innovation();
         publish_state(m);
@@ -109,11 +117,10 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
     }
     if (had_time && T > 0.0) derived().predict(T);
     clear_innovation();
-    if (usable) {
-      const bool used = dim == 4 ? derived().template update<4>(m) : derived().template update<3>(m);
-      ++(used ? run_.updates : run_.rejected);
-    }
-    publish_state(m);
+    bool used = false;
+    if (usable) used = dim == 4 ? derived().template update<4>(m) : derived().template update<3>(m);
+    if (!publish_state(m)) return;
+    if (usable) ++(used ? run_.updates : run_.rejected);
   }
 
   std::unique_ptr<RunResult> end_run() final {
@@ -129,6 +136,7 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
     out.put(r.non_finite);
     out.put(r.rejected);
     out.put(r.counters);
+    out.put(r.refused_non_finite);
   }
   std::unique_ptr<RunResult> load_run_result(ByteReader& in) const final {
     auto r = std::make_unique<FrontEndRunResult>();
@@ -137,6 +145,7 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
     in.get(r->non_finite);
     in.get(r->rejected);
     in.get(r->counters);
+    in.get(r->refused_non_finite);
     return r;
   }
 
@@ -146,6 +155,7 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
     total_.coasted += r.coasted;
     total_.non_finite += r.non_finite;
     total_.rejected += r.rejected;
+    total_.refused_non_finite += r.refused_non_finite;
     for (int i = 0; i < FrontEndRunResult::kMaxCounters; ++i) total_.counters[i] += r.counters[i];
   }
 
@@ -154,6 +164,7 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
     s.metric("coasted", static_cast<double>(total_.coasted));
     if (total_.non_finite) s.metric("non_finite_skipped", static_cast<double>(total_.non_finite));
     if (total_.rejected) s.metric("updates_refused", static_cast<double>(total_.rejected));
+    if (total_.refused_non_finite) s.metric("non_finite_state_refused", static_cast<double>(total_.refused_non_finite));
     for (size_t i = 0; i < spec_.counters.size() && i < FrontEndRunResult::kMaxCounters; ++i)
       s.metric(spec_.counters[i], static_cast<double>(total_.counters[i]));
   }
@@ -273,19 +284,48 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
     est_.nis = 0.0;
   }
 
-  // The published state and covariance are formed only when something sees them (a filter node
-  // without consumers and adapters forms nothing); the filter's own state is the same either way.
-  void publish_state(const Measurement& m) {
+  // Publishes the state, unless it came out non-finite (a division by ~0, an overflow): then the
+  // step is refused -- counted, reported with the node and time -- and the track restarts, so
+  // no NaN or infinity ever leaves a filter. Returns whether it published the state. The
+  // published state and covariance are formed only when something sees them (a filter node
+  // without consumers and adapters forms nothing, so there is nothing to check either); the
+  // filter's own state is the same either way.
+  bool publish_state(const Measurement& m) {
     est_.time = m.time;
     est_.initialised = true;
-    if (observed()) derived().fill_estimate(est_);
+    if (!observed()) {
+      publish(m, est_);
+      return true;
+    }
+    derived().fill_estimate(est_);
+    if (finite(est_)) {
+      publish(m, est_);
+      return true;
+    }
+    ++run_.refused_non_finite;
+    if (!refusal_reported_)
+      warn("the state at t=" + std::to_string(m.time) +
+           " s came out non-finite (NaN or infinity); the step is refused and the track restarted; further ones are "
+           "counted as non_finite_state_refused");
+    refusal_reported_ = true;
+    initialised_ = derived().reset_track();
+    clear_innovation();
+    set_uninitialised(est_, m.time);
     publish(m, est_);
+    return false;
+  }
+
+  // One sum per block: NaN or infinity anywhere makes it non-finite (so does a sum beyond 1e308,
+  // which is no usable state either). Cheaper than an element-wise test on the hot path.
+  static bool finite(const Estimate& e) {
+    return std::isfinite(e.state.sum() + e.covariance.sum() + e.enu.sum() + e.enu_covariance.sum() + e.nis +
+                         e.innovation.sum() + e.innovation_covariance.sum());
   }
 
   FrontEndSpec spec_;
   Diagnostics* diag_ = nullptr;
   double time_ = 0.0;
-  bool has_time_ = false, initialised_ = false, non_finite_reported_ = false;
+  bool has_time_ = false, initialised_ = false, non_finite_reported_ = false, refusal_reported_ = false;
   FrontEndRunResult run_, total_;
   mutable Estimate scratch_;  // read_covariance's, so the published estimate is never touched
 };

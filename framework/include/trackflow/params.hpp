@@ -86,6 +86,15 @@ struct ParamValue {
   std::vector<Params> records;
   SourceLoc where;
   bool from_default = false;
+
+  // Defined in params.cpp, where Params is complete: inline ones would need Params complete
+  // here, which it cannot be (Params holds ParamValues), and clang refuses that cycle.
+  ParamValue();
+  ParamValue(const ParamValue&);
+  ParamValue(ParamValue&&) noexcept;
+  ParamValue& operator=(const ParamValue&);
+  ParamValue& operator=(ParamValue&&) noexcept;
+  ~ParamValue();
 };
 
 // Validated parameters of one node (or of one record inside a Records parameter).

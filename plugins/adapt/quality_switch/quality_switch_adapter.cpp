@@ -47,6 +47,7 @@ struct QualityRunResult final : RunResult {
   std::uint64_t steps = 0, invalid = 0, resets = 0, switches = 0, ungraded = 0;
   std::uint64_t table_steps[2] = {};
   std::uint64_t graded[kChannels][kGrades] = {};
+  std::uint64_t graded_in[2][kChannels][kGrades] = {};  // the same per table in force (beacon, skin)
   double rms_sum[kChannels] = {};
   std::uint64_t rms_count[kChannels] = {};
 };
@@ -96,6 +97,7 @@ class QualitySwitchAdapter final : public Adapter, public RunResultCodec {
         if (grade_[c] >= 0 && g != grade_[c]) ++run_.switches;
         grade_[c] = g;
         ++run_.graded[c][g];
+        ++run_.graded_in[static_cast<int>(table)][c][g];
         run_.rms_sum[c] += rms;
         ++run_.rms_count[c];
       }
@@ -167,7 +169,10 @@ class QualitySwitchAdapter final : public Adapter, public RunResultCodec {
     total_.ungraded += r.ungraded;
     for (int t = 0; t < 2; ++t) total_.table_steps[t] += r.table_steps[t];
     for (int c = 0; c < kChannels; ++c) {
-      for (int g = 0; g < kGrades; ++g) total_.graded[c][g] += r.graded[c][g];
+      for (int g = 0; g < kGrades; ++g) {
+        total_.graded[c][g] += r.graded[c][g];
+        for (int t = 0; t < 2; ++t) total_.graded_in[t][c][g] += r.graded_in[t][c][g];
+      }
       total_.rms_sum[c] += r.rms_sum[c];
       total_.rms_count[c] += r.rms_count[c];
     }
@@ -191,11 +196,31 @@ class QualitySwitchAdapter final : public Adapter, public RunResultCodec {
       s.metric(std::string("mean_rmse_") + kChannelName[c],
                total_.rms_sum[c] / static_cast<double>(total_.rms_count[c]), kChannelUnit[c]);
     }
+    // Per table, when both were in force (paper 000 §IV.3 grades beacon and skin stretches apart).
+    const char* const table_name[2] = {"beacon", "skin"};
+    auto graded_in_table = [&](int t) {
+      std::uint64_t n = 0;
+      for (int g = 0; g < kGrades; ++g) n += total_.graded_in[t][0][g];
+      return n;
+    };
+    if (graded_in_table(0) > 0 && graded_in_table(1) > 0) {
+      for (int t = 0; t < 2; ++t)
+        for (int c = 0; c < kChannels; ++c) {
+          std::uint64_t n = 0;
+          for (int g = 0; g < kGrades; ++g) n += total_.graded_in[t][c][g];
+          if (n == 0) continue;
+          for (int g = 0; g < kGrades; ++g)
+            s.metric(std::string(table_name[t]) + "_" + adapt::grade_name(static_cast<Grade>(g)) + "_fraction_" +
+                         kChannelName[c],
+                     static_cast<double>(total_.graded_in[t][c][g]) / static_cast<double>(n));
+        }
+    }
     if (total_.rms_count[0] == 0)
       s.notes.push_back("no channel was ever graded: fewer than window + 1 consecutive valid measurements per run");
     s.notes.push_back("grades per channel are published on each estimate as annotations grade_range, grade_azimuth, "
                       "grade_elevation (0 best, 1 normal, 2 worst, none until graded); mean_rmse_*: the mean of the "
-                      "graded RMS of differences, the paper's 'RMSE mean' to set reference_* from");
+                      "graded RMS of differences, the paper's 'RMSE mean' to set reference_* from; beacon_* / skin_*: the "
+                      "fractions among the steps of each table, when both were in force");
   }
 
  private:

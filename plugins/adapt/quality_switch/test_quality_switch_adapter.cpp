@@ -185,6 +185,13 @@ TEST_CASE("table follows the measurement mode") {
     const Summary sum = s.summary();
     CHECK(sum.find("skin_table_steps")->value == skin_steps);
     CHECK(sum.find("beacon_table_steps")->value == 7 - skin_steps);
+    // Both tables were in force: the grades are also split by table. With window 2 the steps from
+    // k = 2 on are graded, all BEST here; the beacon (or skin) fraction sums to 1 per channel.
+    REQUIRE(sum.find("beacon_best_fraction_range"));
+    REQUIRE(sum.find("skin_best_fraction_elevation"));
+    CHECK(sum.find("beacon_best_fraction_range")->value == 1.0);
+    CHECK(sum.find("skin_best_fraction_azimuth")->value == 1.0);
+    CHECK(sum.find("skin_worst_fraction_range")->value == 0.0);
   }
 }
 
@@ -354,4 +361,26 @@ nodes:
   REQUIRE(score.find("position_rmse"));
   CHECK(std::isfinite(score.find("position_rmse")->value));
   CHECK(score.find("position_rmse")->value == two.find("score")->summary.find("position_rmse")->value);
+}
+
+// the per-table fractions separate the grades of beacon and skin stretches (paper 000 §IV.3)
+TEST_CASE("grades are reported per table") {
+  Attached s;
+  // Beacon: 0.5 m steps (BEST, RMS 0.5 <= M = 1 m); skin: alternating +-1.5 m (RMS 3 m > 2M: WORST).
+  int k = 0;
+  for (; k < 8; ++k) s.step(meas(0.025 * k, kR0 + 0.5 * k));
+  for (int j = 0; j < 8; ++j, ++k) s.step(meas(0.025 * k, kR0 + (j % 2 ? 1.5 : -1.5), kAz0, kEl0, MeasMode::Skin));
+  const Summary sum = s.summary();
+  // Beacon: graded from its 3rd sample (window 2): 6 BEST. Skin: the first skin step's window holds
+  // a beacon difference and the jump (RMS > 2M), then alternating: all 8 WORST.
+  CHECK(sum.find("beacon_best_fraction_range")->value == 1.0);
+  CHECK(sum.find("skin_worst_fraction_range")->value == 1.0);
+  CHECK(sum.find("skin_best_fraction_range")->value == 0.0);
+  CHECK(sum.find("best_fraction_range")->value == Approx(6.0 / 14.0));
+  // Only one table in force: no per-table split (the overall fractions say it all).
+  Attached one;
+  for (int j = 0; j < 5; ++j) one.step(meas(0.025 * j, kR0 + 0.5 * j));
+  const Summary only = one.summary();
+  CHECK(only.find("best_fraction_range"));
+  CHECK_FALSE(only.find("beacon_best_fraction_range"));
 }

@@ -66,7 +66,6 @@ class UnscentedKalmanFilter final
                  " updates; its negative part was removed there (see alpha, beta, kappa)");
   }
 
-
   template <int M>
   bool correct(const Measurement& m) {
     using MatM = Eigen::Matrix<double, M, M>;

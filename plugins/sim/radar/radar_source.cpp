@@ -1,4 +1,6 @@
 // Purpose: sim.radar — measures Truth as spherical range/azimuth/elevation(/range rate) with bias, modelled noise, shot bursts and mode/lock schedules.
+#include "../common/geodesy.hpp"
+#include "../common/refraction.hpp"
 #include "noise_model.hpp"
 #include "shot_noise.hpp"
 #include "time_windows.hpp"
@@ -8,7 +10,9 @@
 #include <trackflow/plugin.hpp>
 #include <trackflow/rng.hpp>
 
+#include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <string>
 
 namespace trackflow {
@@ -17,6 +21,39 @@ namespace {
 using sim::NoiseSigmas;
 
 enum class ReportedNoise { Actual, Nominal };
+
+// A radar at a geodetic site measures in the pipeline's ENU axes, so its local vertical must be
+// the frame's: within this angle (about 1 km from the frame's origin).
+constexpr double kMaxSiteTilt = 0.01 * std::numbers::pi / 180.0;  // rad
+
+struct RadarPlace {
+  Vec3 position = Vec3::Zero();
+  double height = 0.0;  // above the ellipsoid (site) or the frame's origin (position z)
+};
+
+// `position` in the frame, or `site` among the pipeline's geodetic sites.
+RadarPlace radar_place(const Params& p) {
+  if (!p.given("site")) {
+    const Vec3 pos = p.vec3("position");
+    return {pos, pos.z()};
+  }
+  if (p.given("position")) throw p.error("position", "give either 'position' (ENU) or 'site' (geodetic), not both");
+  const std::vector<sim::Site> sites = sim::read_sites(p);
+  const sim::Site site = sim::find_site(p, sites, "site");
+  const sim::EnuFrame frame = sim::EnuFrame::from_params(p, sites, "site");
+  const double tilt = std::acos(std::clamp(frame.up_at(site.where).z(), -1.0, 1.0));
+  if (tilt > kMaxSiteTilt)
+    throw p.error("site", "'" + site.name + "' is " + std::to_string(tilt * sim::kRadToDeg) +
+                              " deg of arc from the frame's origin: sim.radar measures azimuth and elevation in the "
+                              "pipeline's ENU axes, which are not its local horizon there. Anchor the frame at this "
+                              "radar (pipeline: { frame_origin: " + site.name + " })");
+  return {frame.to_enu(site.where), site.where.height};
+}
+
+// Per-run count of measurements the refraction model left undefined (flagged invalid).
+struct RadarRunResult final : RunResult {
+  std::uint64_t refraction_invalid = 0;
+};
 
 
 // A shot_* parameter written while shot noise is off would be silently ignored.
@@ -39,7 +76,9 @@ class RadarSource final : public Component {
  public:
   explicit RadarSource(const Params& p)
       : node_(p.node()),
-        sensor_position_(p.vec3("position")),
+        place_(radar_place(p)),
+        sensor_position_(place_.position),
+        refraction_(sim::read_elevation_bias(p, place_.height)),
         bias_range_(p.real("bias_range")),
         bias_azimuth_(p.real("bias_azimuth")),
         bias_elevation_(p.real("bias_elevation")),
@@ -70,6 +109,7 @@ class RadarSource final : public Component {
 
   void start_run(const RunContext& ctx) override {
     rng_.reseed(ctx.seed);
+    refraction_invalid_ = 0;
     received_ = 0;
     emitted_ = 0;
     diagnostics_ = ctx.diagnostics;
@@ -93,6 +133,16 @@ class RadarSource final : public Component {
     m_.value(0) = rae(0) + bias_range_;
     m_.value(1) = rae(1) + bias_azimuth_;
     m_.value(2) = rae(2) + bias_elevation_;
+    // Refraction bends the ray up: the radar sees the target b above its geometric elevation.
+    // Skipped entirely when off, so the output is unchanged (signed zeros included).
+    if (refraction_.kind != sim::RefractionKind::None) {
+      bool defined = true;
+      m_.value(2) += refraction_.bias(d, rae(2), defined);
+      if (!defined) {
+        m_.valid = false;
+        ++refraction_invalid_;
+      }
+    }
     if (m_.has_range_rate) m_.value(3) = range_rate(d, t.velocity);
     add_noise(nominal.scaled(shot_.factor(emitted_)));
     m_.value(1) = wrap_angle(m_.value(1));
@@ -105,6 +155,22 @@ class RadarSource final : public Component {
     if (m_.has_range_rate) m_.covariance.diagonal()(3) = reported.range_rate * reported.range_rate;
     ++emitted_;
     out.emit(m_);
+  }
+
+  std::unique_ptr<RunResult> end_run() override {
+    if (refraction_.kind == sim::RefractionKind::None) return nullptr;
+    auto r = std::make_unique<RadarRunResult>();
+    r->refraction_invalid = refraction_invalid_;
+    return r;
+  }
+  void merge(RunResult& r) override { total_refraction_invalid_ += static_cast<RadarRunResult&>(r).refraction_invalid; }
+  void finish(Summary& s, const FinishContext&) override {
+    if (refraction_.kind == sim::RefractionKind::None) return;
+    s.metric("refraction_invalid", static_cast<double>(total_refraction_invalid_));
+    if (total_refraction_invalid_)
+      s.notes.push_back(std::to_string(total_refraction_invalid_) +
+                        " measurement(s) flagged invalid where the refraction model is undefined (Clark below 2 deg "
+                        "with clark_below_2deg: invalid, or no ray reaches the target)");
   }
 
  private:
@@ -136,7 +202,10 @@ class RadarSource final : public Component {
   }
 
   std::string node_;
+  RadarPlace place_;
   Vec3 sensor_position_;
+  sim::ElevationBias refraction_;
+  std::uint64_t refraction_invalid_ = 0, total_refraction_invalid_ = 0;
   double bias_range_, bias_azimuth_, bias_elevation_;
   long long every_;
   sim::NoiseModel noise_;
@@ -201,7 +270,19 @@ const char* const kDoc =
     "Random draws, per emitted measurement, from the run's seed: for noise_model snr one standard normal for the SNR "
     "jitter (drawn even when snr_jitter is 0), then one each for range, azimuth, elevation and, if measured, range "
     "rate. Bursts, schedules, presets and factors only change the sigma multiplying these draws, so they never shift "
-    "the sequence. Truth items skipped by `every` or for being non-finite draw nothing.";
+    "the sequence. Truth items skipped by `every` or for being non-finite draw nothing.\n"
+    "Refraction (paper 004; off by default): the elevation gets b(el) on top of bias_elevation, el the geometric "
+    "elevation, before the noise. clark: b = N0 1e-6 cot(el) above 10 deg, times beta1(u) = c1 - c2/u + c3/u^2 - c4/u^3 "
+    "for 2-10 deg, u = el in clark_theta_unit; below 2 deg clark_below_2deg says whether the measurement is flagged "
+    "invalid (the default: Clark is undefined there and the radar's elevation unreliable), b is held at b(2 deg), or "
+    "the formula is extrapolated. exponential: the apparent elevation of the ray traced through n(h) = 1 + N0 1e-6 "
+    "exp(-h/scale_height) over a sphere of earth_radius, from the radar's height (its site's, else position z) to the "
+    "target; flagged invalid where no ray reaches it. Range delay is not modelled. The summary counts the "
+    "measurements flagged invalid by the model (refraction_invalid). b is measured from the radar's horizon: "
+    "with site, the frame must be anchored at the radar (pipeline.frame_origin).\n"
+    "Geodetic placement: site names one of the pipeline's sites: (WGS-84 latitude, longitude, height), placed in the "
+    "ENU frame anchored at pipeline.frame_origin; azimuth and elevation are measured in the frame's axes, so the "
+    "site must be the frame's origin (within 0.01 deg of arc).";
 
 void register_components(Registrar& r) {
   ComponentDecl d;
@@ -213,6 +294,13 @@ void register_components(Registrar& r) {
   d.params = {
       ParamSpec::real_list("position", dim::length, "radar position in the ENU frame [x east, y north, z up]", 3)
           .def("[0, 0, 0]"),
+      ParamSpec::string("site", "instead of position: the radar's geodetic site, one of the pipeline's sites: (within "
+                                "0.01 deg of arc of pipeline.frame_origin)"),
+      sim::sites_param(),
+      sim::frame_origin_param(),
+      sim::refraction_kind_param("tropospheric refraction bias added to the elevation: none, Clark's model (paper 004) "
+                                 "or an exponential atmosphere ray-traced"),
+      sim::n0_param(),
       ParamSpec::choice<sim::NoiseModelKind>("noise_model",
                                              {{sim::NoiseModelKind::Constant, "constant"},
                                               {sim::NoiseModelKind::Snr, "snr"},
@@ -285,6 +373,8 @@ void register_components(Registrar& r) {
       ParamSpec::integer("sensor_id", "sensor number written into each measurement").def("0").at_least(0).at_most(4294967295.0),
       ParamSpec::integer("every", "measure every N-th truth item received (1: all)").def("1").at_least(1),
   };
+  for (auto& spec : sim::clark_param_specs(true)) d.params.push_back(std::move(spec));
+  for (auto& spec : sim::exponential_param_specs()) d.params.push_back(std::move(spec));
   d.accepts = mask(ItemKind::Truth);
   d.min_inputs = 1;
   d.max_inputs = 1;

@@ -1,6 +1,7 @@
 // Purpose: validation of trajectory segment records and exact propagation of CV, CA, coordinated-turn and launch pieces.
 #include "flight_plan.hpp"
 
+#include "geodetic_launch.hpp"
 #include "launch_profile.hpp"
 
 #include <algorithm>
@@ -116,6 +117,8 @@ Kinematics evaluate(const MotionPiece& p, double t) {
     }
     case Motion::Launch:
       return p.launch->at(dt);
+    case Motion::GeodeticLaunch:
+      return p.geodetic_launch->at(dt);
   }
   return {p.position, p.velocity, Vec3::Zero()};
 }

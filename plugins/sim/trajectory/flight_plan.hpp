@@ -12,11 +12,12 @@ namespace trackflow::sim {
 // The words of sim.trajectory's choice parameters, as enums (ParamSpec::choice<E>).
 enum class SegmentType { ConstantVelocity, ConstantAcceleration, Turn, VelocityChange };
 enum class Profile { None, Kslv1 };
-enum class Earth { Flat, Spherical };
+enum class Earth { Flat, Spherical, Wgs84 };
 
 class LaunchPath;
+class GeodeticLaunchPath;
 
-enum class Motion { ConstantVelocity, ConstantAcceleration, Turn, Launch };
+enum class Motion { ConstantVelocity, ConstantAcceleration, Turn, Launch, GeodeticLaunch };
 
 // One interval of closed-form motion. Velocity changes are not pieces: they are folded into
 // the initial velocity of the piece that follows them.
@@ -28,6 +29,7 @@ struct MotionPiece {
   Vec3 acceleration = Vec3::Zero();  // ConstantAcceleration only
   double turn_rate = 0.0;            // Turn only, rad/s, positive counter-clockwise seen from above
   std::shared_ptr<const LaunchPath> launch;  // Launch only: the path, its time 0 at `start`
+  std::shared_ptr<const GeodeticLaunchPath> geodetic_launch;  // GeodeticLaunch only (earth: wgs84)
 };
 
 struct Kinematics {

@@ -1,4 +1,4 @@
-// Purpose: the KSLV-I profile table, its spline interpolation and placement at the pad (flat or spherical earth).
+// Purpose: the KSLV-I profile table, its shape-preserving interpolation and placement at the pad (flat or spherical earth).
 #include "launch_profile.hpp"
 
 #include <algorithm>

@@ -338,7 +338,8 @@ TEST_CASE("process noise off: output is the deterministic profile") {
   for (const Case c : {Case{&kManoeuvres, false}, Case{&kLaunch, true}}) {
     const Params p = test::params_for("sim.trajectory", *c.yaml);
     const auto pieces = c.launch ? sim::build_launch_plan(p) : sim::build_flight_plan(p);
-    for (const char* off : {"", "process_noise_q: 0 m2/s3\n", "process_noise_q_enu: [0, 0, 0]\n"}) {
+    for (const char* off : {"", "process_noise_q: 0 m2/s3\n", "process_noise_q_enu: [0, 0, 0]\n", "process_noise_q_jerk: 0 m2/s5\n",
+                            "process_noise_q_jerk_enu: [0, 0, 0]\n"}) {
       INFO(*c.yaml << off);
       for (std::uint64_t seed : {1u, 99u}) {
         const auto truths = fly(*c.yaml + off, seed, seed);
@@ -427,6 +428,73 @@ TEST_CASE("process noise increments have the CV model covariance") {
   check_cov(end_sum / R, model(K * T), R);  // R = 400: 5 sd is 35 % on a diagonal entry
 }
 
+TEST_CASE("white jerk increments have the CA model covariance") {
+  // Per axis d = truth - profile = [p, v, a] obeys d' = F d + w, F = [[1, T, T²/2], [0, 1, T],
+  // [0, 0, 1]], w ~ N(0, q Q1), Q1 = [[T⁵/20, T⁴/8, T³/6], [T⁴/8, T³/3, T²/2], [T³/6, T²/2, T]]
+  // (paper 000 eq 3.19). Moment estimates of the 9-vector w against q Q1 within 5 sd, as in the
+  // white-acceleration test above (a wrong factor, e.g. T⁵/6 or T⁴/2, is off by far more).
+  const Vec3 q(4.0, 1.0, 0.25);
+  const double T = 0.1;
+  const int R = 400;
+  const std::string base = "rate: 10 Hz\ninitial_position: [1 m, 2 m, 3 m]\ninitial_velocity: [5 m/s, -5 m/s, 0]\n"
+                           "segments: [{type: constant_velocity, duration: 10 s}]\n";
+  const auto profile = fly(base);
+  const int K = static_cast<int>(profile.size()) - 1;
+  REQUIRE(K == 100);
+  using Mat9 = Eigen::Matrix<double, 9, 9>;
+  using Vec9 = Eigen::Matrix<double, 9, 1>;
+  Mat9 sum = Mat9::Zero(), end_sum = Mat9::Zero();
+  auto deviation = [&](const Truth& noisy, const Truth& clean) {
+    Vec9 d;
+    for (int a = 0; a < 3; ++a) {
+      d(3 * a) = noisy.position[a] - clean.position[a];
+      d(3 * a + 1) = noisy.velocity[a] - clean.velocity[a];
+      d(3 * a + 2) = noisy.acceleration[a] - clean.acceleration[a];
+    }
+    return d;
+  };
+  for (int r = 0; r < R; ++r) {
+    const auto truths = fly(base + "process_noise_q_jerk_enu: [4, 1, 0.25]\n", derive_seed(11, r, "truth"), r);
+    REQUIRE(truths.size() == profile.size());
+    CHECK(deviation(truths[0], profile[0]).norm() == 0.0);
+    for (int k = 0; k < K; ++k) {
+      const Vec9 d0 = deviation(truths[k], profile[k]), d1 = deviation(truths[k + 1], profile[k + 1]);
+      Vec9 w;
+      for (int a = 0; a < 3; ++a) {
+        const int i = 3 * a;
+        w(i) = d1(i) - d0(i) - T * d0(i + 1) - 0.5 * T * T * d0(i + 2);
+        w(i + 1) = d1(i + 1) - d0(i + 1) - T * d0(i + 2);
+        w(i + 2) = d1(i + 2) - d0(i + 2);
+      }
+      sum += w * w.transpose();
+    }
+    const Vec9 d = deviation(truths.back(), profile.back());
+    end_sum += d * d.transpose();
+  }
+  // The covariance after time t from zero: q [[t⁵/20, t⁴/8, t³/6], [t⁴/8, t³/3, t²/2], [t³/6, t²/2, t]].
+  auto model = [&](double t) {
+    Mat9 m = Mat9::Zero();
+    const double c[3][3] = {{std::pow(t, 5) / 20, std::pow(t, 4) / 8, std::pow(t, 3) / 6},
+                            {std::pow(t, 4) / 8, std::pow(t, 3) / 3, t * t / 2},
+                            {std::pow(t, 3) / 6, t * t / 2, t}};
+    for (int a = 0; a < 3; ++a)
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) m(3 * a + i, 3 * a + j) = q[a] * c[i][j];
+    return m;
+  };
+  auto check_cov = [](const Mat9& S, const Mat9& E, double n) {
+    for (int i = 0; i < 9; ++i)
+      for (int j = i; j < 9; ++j) {
+        const double sd = std::sqrt((E(i, i) * E(j, j) + E(i, j) * E(i, j)) / n);
+        INFO("entry " << i << " " << j << ": " << S(i, j) << " expected " << E(i, j) << " sd " << sd);
+        CHECK(std::abs(S(i, j) - E(i, j)) < 5 * sd);
+      }
+  };
+  const double N = static_cast<double>(R) * K;
+  check_cov(sum / N, model(T), N);
+  check_cov(end_sum / R, model(K * T), R);
+}
+
 TEST_CASE("process noise: same seed same path - new run new path") {
   const std::string yaml = kManoeuvres + "process_noise_q: 2 m2/s3\n";
   auto gen = test::make("sim.trajectory", yaml, "truth");
@@ -463,4 +531,11 @@ TEST_CASE("process noise parameters are checked") {
   CHECK_THAT(config_error(head + "process_noise_q_enu: [1, -1, 1]\n"), Catch::Matchers::Contains("process_noise_q_enu"));
   CHECK_THAT(config_error(head + "process_noise_q_enu: [1, 1]\n"), Catch::Matchers::Contains("process_noise_q_enu"));
   CHECK(config_error(head + "process_noise_q: 1 m2/s3\n").empty());
+  CHECK(config_error(head + "process_noise_q_jerk: 1 m2/s5\n").empty());
+  CHECK_THAT(config_error(head + "process_noise_q_jerk: 1 m2/s3\n"), Catch::Matchers::Contains("process_noise_q_jerk"));
+  CHECK_THAT(config_error(head + "process_noise_q_jerk: 1\nprocess_noise_q_jerk_enu: [1, 1, 1]\n"),
+             Catch::Matchers::Contains("'process_noise_q_jerk_enu'"));
+  CHECK_THAT(config_error(head + "process_noise_q: 1\nprocess_noise_q_jerk: 1\n"), Catch::Matchers::Contains("not both"));
+  CHECK_THAT(config_error(head + "process_noise_q_enu: [1, 1, 1]\nprocess_noise_q_jerk_enu: [1, 1, 1]\n"),
+             Catch::Matchers::Contains("not both"));
 }

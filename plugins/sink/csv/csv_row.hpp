@@ -1,4 +1,4 @@
-// Purpose: appends CSV cells to a reused string buffer: "%.*g" numbers, empty cells for missing or non-finite values.
+// Purpose: appends CSV cells to a reused string buffer: "%.*g" numbers, empty cells for missing values, "nan"/"inf" (counted) for non-finite ones.
 #pragma once
 
 #include <cmath>
@@ -13,9 +13,15 @@ class RowWriter {
  public:
   RowWriter(std::string& out, int precision) : out_(out), precision_(precision) {}
 
+  // A value that exists. Non-finite ones are written as they are ("nan", "inf", "-inf") -- an
+  // empty cell means "no value", which a NaN is not -- and counted, so the sink can fail the run.
   void real(double v) {
     separate();
-    if (!std::isfinite(v)) return;  // never "nan" or "inf" in the file
+    if (!std::isfinite(v)) {
+      out_.append(std::isnan(v) ? "nan" : v > 0 ? "inf" : "-inf");
+      if (non_finite_++ == 0) first_non_finite_ = column_;
+      return;
+    }
     char buf[40];
     const int n = std::snprintf(buf, sizeof buf, "%.*g", precision_, v);
     out_.append(buf, static_cast<size_t>(n));
@@ -40,16 +46,24 @@ class RowWriter {
   void end() {
     out_.push_back('\n');
     first_ = true;
+    column_ = 0;
   }
+  // Non-finite values written so far, and the 0-based column of the first.
+  int non_finite() const { return non_finite_; }
+  int first_non_finite_column() const { return first_non_finite_; }
 
  private:
   void separate() {
     if (!first_) out_.push_back(',');
+    if (!first_) ++column_;
     first_ = false;
   }
   std::string& out_;
   int precision_;
   bool first_ = true;
+  int column_ = 0;
+  int non_finite_ = 0;
+  int first_non_finite_ = -1;
 };
 
 // A field quoted per RFC 4180 when it holds a separator, a quote or a line break.

@@ -2,14 +2,20 @@
 #include "csv_row.hpp"
 
 #include <trackflow/geometry.hpp>
+#include <trackflow/output_path.hpp>
 #include <trackflow/plugin.hpp>
+
+#include <unistd.h>
 
 #include <Eigen/Cholesky>
 
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
+#include <cstdio>
+#include <cstdlib>
 #include <cstring>
+#include <memory>
 #include <filesystem>
 #include <fstream>
 #include <limits>
@@ -29,10 +35,26 @@ constexpr const char* kCovarianceHeader =
 
 // Truth samples within this of an item's time are its truth (the same default as sink.metrics).
 constexpr double kTimeTolerance = 1e-6;
+// Truth older than this before the latest item (and every pending row) is no longer kept.
+constexpr double kPruneMargin = 1.0;
+
+// An anonymous temporary file (unlinked at once: nothing is left behind, whatever happens).
+struct TempFile {
+  std::FILE* f = nullptr;
+  TempFile() = default;
+  TempFile(const TempFile&) = delete;
+  TempFile& operator=(const TempFile&) = delete;
+  ~TempFile() {
+    if (f) std::fclose(f);
+  }
+};
 
 struct CsvRunResult final : RunResult {
-  std::string rows;
+  std::unique_ptr<TempFile> spilled;  // the run's first rows, when they outgrew memory
+  std::string rows;                   // the rest
   std::uint64_t count = 0;
+  std::uint64_t non_finite = 0;
+  std::string first_non_finite;       // "run 3, t=1.5 s, column x"
 };
 
 // An item waiting for the truth of its time step, which may arrive after it.
@@ -42,8 +64,10 @@ struct PendingRow {
   std::uint32_t target = 0;
   bool measurement = false;
   bool updated = false;
+  bool has_nis = false;
   bool has_velocity = false;
   bool has_sigma = false;
+  std::uint8_t sigma_missing = 0;  // bit i: variance i negative, so sigma i has no value
   double nis = 0.0;
   Vec6 value = Vec6::Zero();
   Vec6 sigma = Vec6::Zero();
@@ -52,18 +76,50 @@ struct PendingRow {
   int annotation_count = 0;
 };
 
+// A run's rows in memory up to this size; beyond, they go to a temporary file next to the
+// output, so a 10^6-step run never holds its whole text.
+constexpr std::size_t kSpillBytes = std::size_t{4} << 20;
+
+std::string column_name(int column, const std::vector<std::string>& annotation_columns, bool full_covariance) {
+  std::string header = kHeader;
+  if (full_covariance) header += kCovarianceHeader;
+  for (const auto& a : annotation_columns) header += "," + a;
+  int c = 0;
+  std::size_t start = 0;
+  for (;;) {
+    const std::size_t comma = header.find(',', start);
+    if (c == column) return header.substr(start, comma == std::string::npos ? std::string::npos : comma - start);
+    if (comma == std::string::npos) return "?";
+    start = comma + 1;
+    ++c;
+  }
+}
+
 class CsvSink final : public Component {
  public:
   explicit CsvSink(const Params& p)
       : path_(p.has("path") ? p.text("path") : std::string()),
         path_where_(p.where("path")),
+        node_(p.node()),
         include_measurements_(p.boolean("include_measurements")),
         full_covariance_(p.boolean("full_covariance")),
         precision_(static_cast<int>(p.integer("precision"))) {
     if (p.has("path") && path_.empty()) throw p.error("path", "must not be empty (leave it out for '<node id>.csv')");
+    // A pipeline file from someone else must not write anywhere but under --out.
+    if (std::string why = output_path_problem(path_); !why.empty())
+      throw p.error("path", why + " (pass --allow-outside-out on the command line to allow it)");
     truth_.reserve(4096);
     pending_.reserve(1024);
     rows_.reserve(std::size_t{1} << 20);
+  }
+
+  ~CsvSink() override {
+    // An ensemble that did not finish leaves no half-written file under the real name.
+    if (out_) {
+      std::fclose(out_);
+      std::error_code ec;
+      std::filesystem::remove(partial_, ec);
+    }
   }
 
   void set_inputs(const std::vector<InputInfo>& inputs) override {
@@ -90,8 +146,14 @@ class CsvSink final : public Component {
     run_ = ctx.run;
     truth_.clear();
     pending_.clear();
+    head_ = 0;
     rows_.clear();
+    spill_.reset();
     row_count_ = 0;
+    non_finite_ = 0;
+    first_non_finite_.clear();
+    in_time_order_ = true;
+    latest_arrival_ = -std::numeric_limits<double>::infinity();
     latest_truth_ = -std::numeric_limits<double>::infinity();
   }
 
@@ -103,6 +165,7 @@ class CsvSink final : public Component {
                                      [](const Truth& a, const Truth& b) { return a.time < b.time; }),
                     t);
     latest_truth_ = std::max(latest_truth_, t.time);
+    arrived(t.time);
     flush(false);
   }
 
@@ -113,14 +176,21 @@ class CsvSink final : public Component {
     r.port = port;
     r.target = e.target;
     r.updated = e.updated;
-    r.nis = e.updated && e.innovation.size() > 0 ? e.nis : std::numeric_limits<double>::quiet_NaN();
+    r.has_nis = e.updated && e.innovation.size() > 0;
+    r.nis = e.nis;
     r.value = e.enu;
     r.has_velocity = true;
     r.has_sigma = true;
-    for (int i = 0; i < 6; ++i) r.sigma(i) = e.enu_covariance(i, i) >= 0.0 ? std::sqrt(e.enu_covariance(i, i)) : NAN;
+    r.sigma_missing = 0;
+    for (int i = 0; i < 6; ++i) {
+      const double v = e.enu_covariance(i, i);
+      r.sigma(i) = std::sqrt(v);
+      if (v < 0.0) r.sigma_missing |= static_cast<std::uint8_t>(1u << i);  // NaN stays a value: "nan"
+    }
     r.covariance = e.enu_covariance;
     r.annotation_count = e.annotation_count;
     for (int i = 0; i < e.annotation_count; ++i) r.annotations[i] = e.annotations[i];
+    arrived(e.time);
     flush(false);
   }
 
@@ -130,59 +200,152 @@ class CsvSink final : public Component {
     r.time = m.time;
     r.port = port;
     r.measurement = true;
+    r.sigma_missing = 0;
     if (m.frame == Frame::Cartesian) {
       r.value.head<3>() = m.value.head<3>();
       r.has_sigma = m.covariance.rows() >= 3 && m.covariance.cols() >= 3;
-      for (int i = 0; i < 3 && r.has_sigma; ++i)
-        r.sigma(i) = m.covariance(i, i) >= 0.0 ? std::sqrt(m.covariance(i, i)) : NAN;
+      for (int i = 0; i < 3 && r.has_sigma; ++i) {
+        const double v = m.covariance(i, i);
+        r.sigma(i) = std::sqrt(v);
+        if (v < 0.0) r.sigma_missing |= static_cast<std::uint8_t>(1u << i);
+      }
       if (r.has_sigma) r.covariance.topLeftCorner<3, 3>() = m.covariance.topLeftCorner(3, 3);
     } else {
       r.value.head<3>() = spherical_to_enu(m.value(0), m.value(1), m.value(2), m.azimuth) + m.sensor_position;
     }
+    arrived(m.time);
     flush(false);
   }
 
   std::unique_ptr<RunResult> end_run() override {
     flush(true);
     auto r = std::make_unique<CsvRunResult>();
+    r->spilled = std::move(spill_);
     r->rows = rows_;
     r->count = row_count_;
+    r->non_finite = non_finite_;
+    r->first_non_finite = first_non_finite_;
     return r;
   }
 
   void merge(RunResult& result) override {
     auto& r = static_cast<CsvRunResult&>(result);
-    file_ += r.rows;
     total_rows_ += r.count;
+    if (r.non_finite && !non_finite_total_) first_non_finite_total_ = r.first_non_finite;
+    non_finite_total_ += r.non_finite;
+    // Streamed in run order into the file while the ensemble runs (the engine tells every
+    // thread the output folder), so memory does not grow with the ensemble.
+    if (!out_ && !output_directory().empty()) open(output_directory());
+    if (out_) {
+      if (r.spilled) append_file(r.spilled->f);
+      put(r.rows.data(), r.rows.size());
+    } else {
+      if (r.spilled) {
+        std::rewind(r.spilled->f);
+        char buf[1 << 16];
+        for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, r.spilled->f)) > 0;) file_.append(buf, n);
+      }
+      file_ += r.rows;
+    }
   }
 
   void finish(Summary& summary, const FinishContext& ctx) override {
-    namespace fs = std::filesystem;
-    const fs::path file = fs::path(ctx.output_dir.empty() ? "." : ctx.output_dir) /
-                          (path_.empty() ? ctx.node + ".csv" : path_);
+    if (!out_) open(ctx.output_dir);
+    put(file_.data(), file_.size());
+    file_.clear();
+    if (std::fflush(out_) != 0 || std::ferror(out_)) fail_write(errno);
+    std::FILE* f = out_;
+    out_ = nullptr;
+    if (std::fclose(f) != 0) fail_write(errno);
     std::error_code ec;
-    if (file.has_parent_path()) fs::create_directories(file.parent_path(), ec);
-    if (ec) throw ConfigError("cannot create the folder '" + file.parent_path().string() + "': " + ec.message(), path_where_, ctx.node);
-    std::ofstream os(file, std::ios::binary | std::ios::trunc);
-    if (os) {
-      os << kHeader;
-      if (full_covariance_) os << kCovarianceHeader;
-      for (const auto& name : annotation_columns_) os << ',' << csv::quoted(name);
-      os << '\n';
-      os.write(file_.data(), static_cast<std::streamsize>(file_.size()));
-      os.flush();
-    }
-    if (!os)
-      throw ConfigError("cannot write '" + file.string() + "': " + std::strerror(errno) + " (check 'path' and --out)",
+    std::filesystem::rename(partial_, file_path_, ec);
+    if (ec) {
+      std::filesystem::remove(partial_, ec);
+      throw ConfigError("cannot write '" + file_path_.string() + "': " + ec.message() + " (check 'path' and --out)",
                         path_where_, ctx.node);
-    summary.files.push_back(file.string());
+    }
+    summary.files.push_back(file_path_.string());
     summary.metric("rows", static_cast<double>(total_rows_));
     if (total_rows_ == 0) summary.notes.push_back("no rows: no initialised estimate" +
                                                   std::string(include_measurements_ ? " or valid measurement" : "") +
                                                   " reached this sink");
+    // A NaN that reached the file is written as "nan", never hidden as an empty (missing) cell,
+    // and it fails the run: some upstream node produced it.
+    if (non_finite_total_)
+      throw DataError("wrote " + std::to_string(non_finite_total_) +
+                      " non-finite value(s) (nan/inf) into " + file_path_.string() + ", the first in " +
+                      first_non_finite_total_ + "; an upstream node produced them");
   }
 
  private:
+  void open(const std::string& output_dir) {
+    namespace fs = std::filesystem;
+    file_path_ = fs::path(output_dir.empty() ? "." : output_dir) / (path_.empty() ? node_ + ".csv" : path_);
+    partial_ = file_path_;
+    partial_ += ".partial";
+    std::error_code ec;
+    if (file_path_.has_parent_path()) fs::create_directories(file_path_.parent_path(), ec);
+    if (ec)
+      throw ConfigError("cannot create the folder '" + file_path_.parent_path().string() + "': " + ec.message(),
+                        path_where_, node_);
+    if (fs::is_directory(file_path_, ec))
+      throw ConfigError("cannot write '" + file_path_.string() + "': it is a folder (check 'path' and --out)",
+                        path_where_, node_);
+    out_ = std::fopen(partial_.c_str(), "wb");
+    if (!out_)
+      throw ConfigError("cannot write '" + partial_.string() + "': " + std::strerror(errno) + " (check 'path' and --out)",
+                        path_where_, node_);
+    std::string header = kHeader;
+    if (full_covariance_) header += kCovarianceHeader;
+    for (const auto& name : annotation_columns_) header += ',' + csv::quoted(name);
+    header += '\n';
+    put(header.data(), header.size());
+  }
+
+  void put(const char* data, std::size_t n) {
+    if (n && std::fwrite(data, 1, n, out_) != n) fail_write(errno);
+  }
+
+  void append_file(std::FILE* in) {
+    std::rewind(in);
+    char buf[1 << 16];
+    for (std::size_t n; (n = std::fread(buf, 1, sizeof buf, in)) > 0;) put(buf, n);
+    if (std::ferror(in)) throw DataError("sink.csv (node '" + node_ + "'): cannot read back its temporary file");
+  }
+
+  // A full disk is an error of the run, found when it happens, not a file silently cut short.
+  [[noreturn]] void fail_write(int err) {
+    throw ConfigError("cannot write '" + file_path_.string() + "': " + std::strerror(err ? err : EIO) +
+                          " (check the space on the disk, 'path' and --out)",
+                      path_where_, node_);
+  }
+
+  // Moves the rows of this run to a temporary file in the output folder when they outgrow
+  // memory. Without an output folder (a component used directly) they stay in memory.
+  void maybe_spill() {
+    if (rows_.size() < kSpillBytes || output_directory().empty()) return;
+    if (!spill_) {
+      namespace fs = std::filesystem;
+      std::error_code ec;
+      fs::create_directories(output_directory(), ec);
+      std::string pattern = (fs::path(output_directory()) / ("." + node_ + ".run-XXXXXX")).string();
+      const int fd = ::mkstemp(pattern.data());
+      if (fd < 0) return;  // stays in memory
+      ::unlink(pattern.c_str());
+      spill_ = std::make_unique<TempFile>();
+      spill_->f = ::fdopen(fd, "w+b");
+      if (!spill_->f) {
+        ::close(fd);
+        spill_.reset();
+        return;
+      }
+    }
+    if (std::fwrite(rows_.data(), 1, rows_.size(), spill_->f) != rows_.size())
+      throw ConfigError(std::string("cannot write a temporary file in the output folder: ") + std::strerror(errno),
+                        path_where_, node_);
+    rows_.clear();
+  }
+
   // Rows leave in arrival order once all truth of their time step can have arrived (a later
   // truth sample has), or at the end of the run. The file is the same whichever happens.
   void flush(bool end_of_run) {
@@ -191,7 +354,34 @@ class CsvSink final : public Component {
     if (head_ == pending_.size()) {
       pending_.clear();
       head_ = 0;
+    } else if (head_ >= 1024 && 2 * head_ >= pending_.size()) {
+      // Written rows leave the queue even while one always waits (the estimate of a step
+      // arrives before the truth of the next): the queue holds a few rows, not the run.
+      pending_.erase(pending_.begin(), pending_.begin() + static_cast<std::ptrdiff_t>(head_));
+      head_ = 0;
     }
+    prune_truth();
+    maybe_spill();
+  }
+
+  // Items reach a sink in time order (sources are merged by time); what arrives more than
+  // kPruneMargin before the latest item means they do not, and truth is then kept whole.
+  void arrived(double t) {
+    if (t < latest_arrival_ - kPruneMargin) in_time_order_ = false;
+    latest_arrival_ = std::max(latest_arrival_, t);
+  }
+
+  // Truth samples no future row can match are dropped, so a long run keeps a window of truth,
+  // not all of it: future rows come no earlier than kPruneMargin before the latest item (time
+  // order), pending rows are kept with theirs. Pruning stops for the run if the order breaks.
+  void prune_truth() {
+    if (truth_.size() < 8192 || !in_time_order_) return;
+    double needed = latest_arrival_;
+    for (std::size_t i = head_; i < pending_.size(); ++i) needed = std::min(needed, pending_[i].time);
+    const double keep_from = needed - kPruneMargin - 2 * kTimeTolerance;
+    auto it = std::lower_bound(truth_.begin(), truth_.end(), keep_from,
+                               [](const Truth& s, double time) { return s.time < time; });
+    if (it - truth_.begin() > static_cast<std::ptrdiff_t>(truth_.size() / 2)) truth_.erase(truth_.begin(), it);
   }
 
   // The truth sample at `t`: the one of the same target if present, else the only target
@@ -228,17 +418,22 @@ class CsvSink final : public Component {
     else
       w.text(r.updated ? "1" : "0");
     for (int i = 0; i < 6; ++i) w.real_if(i < 3 || r.has_velocity, r.value(i));
-    for (int i = 0; i < 6; ++i) w.real_if(r.has_sigma && (i < 3 || r.has_velocity), r.sigma(i));
-    w.real_if(!r.measurement && r.updated, r.nis);
+    for (int i = 0; i < 6; ++i)
+      w.real_if(r.has_sigma && (i < 3 || r.has_velocity) && !(r.sigma_missing & (1u << i)), r.sigma(i));
+    w.real_if(!r.measurement && r.has_nis, r.nis);
     const Truth* t = truth_at(r.time, r.target, !r.measurement);
     Vec6 truth = Vec6::Zero();
     if (t) truth << t->position, t->velocity;
-    double nees = std::numeric_limits<double>::quiet_NaN();
+    double nees = 0.0;
+    bool has_nees = false;
     if (t && !r.measurement && r.covariance.allFinite()) {
       const Eigen::LLT<Mat6> llt(r.covariance);
-      if (llt.info() == Eigen::Success) nees = llt.matrixL().solve(r.value - truth).squaredNorm();
+      if (llt.info() == Eigen::Success) {
+        nees = llt.matrixL().solve(r.value - truth).squaredNorm();
+        has_nees = true;
+      }
     }
-    w.real(nees);
+    w.real_if(has_nees, nees);
     for (int i = 0; i < 6; ++i) w.real_if(t != nullptr, truth(i));
     std::fill(row_annotations_.begin(), row_annotations_.end(), std::numeric_limits<double>::quiet_NaN());
     if (!r.measurement && r.port >= 0 && static_cast<size_t>(r.port) < column_of_.size()) {
@@ -249,13 +444,24 @@ class CsvSink final : public Component {
     if (full_covariance_)
       for (int i = 0; i < 6; ++i)
         for (int j = i; j < 6; ++j) w.real_if(r.has_sigma && (j < 3 || r.has_velocity), r.covariance(i, j));
+    // NaN is an adapter's "no value yet" (Adapter::annotate): empty.
     for (double a : row_annotations_) w.real_if(!std::isnan(a), a);
     w.end();
     ++row_count_;
+    if (w.non_finite()) {
+      if (non_finite_ == 0) {
+        char t_text[40];
+        std::snprintf(t_text, sizeof t_text, "%.10g", r.time);
+        first_non_finite_ = "run " + std::to_string(run_) + ", t=" + t_text + " s, column " +
+                            column_name(w.first_non_finite_column(), annotation_columns_, full_covariance_);
+      }
+      non_finite_ += static_cast<std::uint64_t>(w.non_finite());
+    }
   }
 
   const std::string path_;
   const SourceLoc path_where_;
+  const std::string node_;
   const bool include_measurements_;
   const bool full_covariance_;
   const int precision_;
@@ -270,11 +476,20 @@ class CsvSink final : public Component {
   std::vector<PendingRow> pending_;
   size_t head_ = 0;
   double latest_truth_ = -std::numeric_limits<double>::infinity();
+  double latest_arrival_ = -std::numeric_limits<double>::infinity();
+  bool in_time_order_ = true;
   std::string rows_;
+  std::unique_ptr<TempFile> spill_;
   std::uint64_t row_count_ = 0;
+  std::uint64_t non_finite_ = 0;
+  std::string first_non_finite_;
   // Aggregating instance.
-  std::string file_;
+  std::string file_;  // rows merged while no output folder was known (direct use)
+  std::FILE* out_ = nullptr;
+  std::filesystem::path file_path_, partial_;
   std::uint64_t total_rows_ = 0;
+  std::uint64_t non_finite_total_ = 0;
+  std::string first_non_finite_total_;
 };
 
 void register_components(Registrar& r) {
@@ -289,14 +504,17 @@ void register_components(Registrar& r) {
       "grade, 0 best, 1 normal, 2 worst; adaptive_r.sigma_x: adapt.innovation_r's adapted sigma, m), empty when the "
       "adapter has published none yet. source is the upstream node id; kind is estimate or measurement. Truth "
       "columns and nees are filled when a truth sample lies within 1 us of the row's time, nis when the estimate "
-      "was updated; missing values are empty cells. With full_covariance: true, 21 more columns hold the upper "
+      "was updated; missing values are empty cells, and a value that is NaN or infinite is written as nan, inf or -inf "
+      "and fails the run (exit 2). The file is streamed in run order while the ensemble runs (written as <file>.partial, "
+      "renamed when complete). With full_covariance: true, 21 more columns hold the upper "
       "triangle of the ENU covariance row by row (x y z vx vy vz; m2, m2/s, m2/s2; Cartesian measurement rows: their "
       "position block). "
       "Measurement rows carry the Cartesian position (spherical ones converted) and, when Cartesian, the sigmas "
       "of the covariance diagonal. Only initialised estimates and valid measurements are written. Rows are in "
       "run order, then arrival order, so the file is identical for a given seed whatever the thread count.";
   d.params = {
-      ParamSpec::string("path", "output file relative to --out (default: <node id>.csv)"),
+      ParamSpec::string("path", "output file relative to --out (default: <node id>.csv); absolute paths and '..' are "
+                                "refused unless the command line has --allow-outside-out"),
       ParamSpec::boolean("include_measurements", "also write measurement rows").def("false"),
       ParamSpec::boolean("full_covariance",
                          "also write the upper triangle of the ENU covariance (cov_x_x ... cov_vz_vz; m2, m2/s, m2/s2)")

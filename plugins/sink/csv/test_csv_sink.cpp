@@ -1,5 +1,7 @@
 // Purpose: tests of sink.csv: header and rows, values against the inputs, empty cells, run order, measurement rows, paths.
 #include <trackflow/geometry.hpp>
+#include <trackflow/host/guard.hpp>
+#include <trackflow/output_path.hpp>
 
 #include <Eigen/Dense>
 #include <catch2/catch.hpp>
@@ -349,4 +351,85 @@ TEST_CASE("relative path and precision") {
   CHECK(rows[1][X] == "1.235e+05");
   CHECK(rows[1][TX].empty());
   CHECK_THROWS_AS(test::make("sink.csv", "{ precision: 0 }"), ConfigError);
+}
+
+// with an output folder known (as in the engine) rows are streamed at merge time, in run order
+TEST_CASE("rows stream into a partial file renamed at the end") {
+  const std::string reference = ensemble_file(scratch("stream_ref"), {0, 1, 2}, 1, [](std::uint64_t) { return 0; });
+  const fs::path dir = scratch("stream");
+  const std::string out = dir.string();
+  host::OutputDirectoryScope scope(out);
+  auto worker = make_csv("{}");
+  auto aggregate = make_csv("{}");
+  Diagnostics diag;
+  for (std::uint64_t r = 0; r < 3; ++r) {
+    worker->start_run({r, 1, &diag});
+    feed(*worker, r);
+    auto result = worker->end_run();
+    aggregate->merge(*result);
+    // Written as the runs are merged, under a name that is not the final one.
+    CHECK(fs::exists(dir / "log.csv.partial"));
+    CHECK_FALSE(fs::exists(dir / "log.csv"));
+  }
+  Summary s;
+  aggregate->finish(s, {"log", out, 3});
+  CHECK_FALSE(fs::exists(dir / "log.csv.partial"));
+  // Byte-identical to the file written all at once without an output folder.
+  CHECK(slurp(dir / "log.csv") == reference);
+}
+
+// a sink that is destroyed before finish (a failed ensemble) leaves no file behind
+TEST_CASE("an unfinished ensemble leaves no file") {
+  const fs::path dir = scratch("unfinished");
+  const std::string out = dir.string();
+  {
+    host::OutputDirectoryScope scope(out);
+    auto worker = make_csv("{}");
+    auto aggregate = make_csv("{}");
+    Diagnostics diag;
+    worker->start_run({0, 1, &diag});
+    feed(*worker, 0);
+    auto result = worker->end_run();
+    aggregate->merge(*result);
+    CHECK(fs::exists(dir / "log.csv.partial"));
+  }
+  CHECK_FALSE(fs::exists(dir / "log.csv.partial"));
+  CHECK_FALSE(fs::exists(dir / "log.csv"));
+}
+
+// a NaN is written as nan (not as an empty, missing cell) and fails the run
+TEST_CASE("a NaN value is written as nan and fails the run") {
+  const fs::path dir = scratch("nan");
+  auto c = make_csv("{}", {kKf, kTruth});
+  Diagnostics diag;
+  c->start_run({0, 1, &diag});
+  c->on_truth(truth(0.0, Vec3(1, 2, 3), Vec3::Zero()), 1);
+  Vec6 x = Vec6::Zero();
+  x(1) = std::numeric_limits<double>::quiet_NaN();
+  c->on_estimate(estimate(0.0, x, Mat6::Identity()), 0);
+  c->on_truth(truth(1.0, Vec3(1, 2, 3), Vec3::Zero()), 1);
+  auto result = c->end_run();
+  c->merge(*result);
+  Summary s;
+  try {
+    c->finish(s, {"log", dir.string(), 1});
+    FAIL("a NaN in the file must fail the run");
+  } catch (const DataError& e) {
+    CHECK_THAT(e.what(), Catch::Matchers::Contains("non-finite value(s) (nan/inf)"));
+    CHECK_THAT(e.what(), Catch::Matchers::Contains("the first in run 0, t=0 s, column y"));
+  }
+  const auto rows = parse(slurp(dir / "log.csv"));
+  REQUIRE(rows.size() == 2);
+  CHECK(rows[1][Y] == "nan");
+  CHECK(rows[1][Nees] == "nan");  // computed from the NaN: a NaN too, not a missing value
+}
+
+// a path outside --out is refused when the node is built, unless the user allowed it
+TEST_CASE("paths outside the output folder are refused") {
+  allow_output_outside(false);
+  CHECK_THROWS_WITH(test::make("sink.csv", "{ path: /tmp/x.csv }"), Catch::Matchers::Contains("absolute path"));
+  CHECK_THROWS_WITH(test::make("sink.csv", "{ path: ../x.csv }"), Catch::Matchers::Contains("leaves the output folder"));
+  allow_output_outside(true);
+  CHECK_NOTHROW(test::make("sink.csv", "{ path: /tmp/x.csv }"));
+  allow_output_outside(false);
 }

@@ -5,6 +5,8 @@
 #include <trackflow/common_params.hpp>
 #include <trackflow/plugin.hpp>
 
+#include <algorithm>
+#include <cctype>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -12,6 +14,9 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <numbers>
 
 namespace trackflow {
@@ -62,18 +67,113 @@ fs::path resolve_path(const Params& p) {
   return path;
 }
 
+// A log larger than this is refused rather than read into memory.
+constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t{1} << 30;
+
 std::string read_file(const Params& p, const fs::path& path) {
   std::error_code ec;
   if (fs::is_directory(path, ec)) throw p.error("path", "'" + path.string() + "' is a directory, not a CSV file");
+  // A FIFO would block and a device (/dev/zero) never end: only regular files are logs.
+  const fs::file_status st = fs::status(path, ec);
+  if (!ec && fs::exists(st) && !fs::is_regular_file(st))
+    throw p.error("path", "'" + path.string() + "' is not a regular file");
   std::ifstream in(path, std::ios::binary);
   if (!in) throw p.error("path", "cannot open '" + path.string() + "': " + std::strerror(errno));
-  in.seekg(0, std::ios::end);
-  const auto size = in.tellg();
-  in.seekg(0, std::ios::beg);
-  std::string text(size > 0 ? static_cast<std::size_t>(size) : 0, '\0');
+  const std::uintmax_t size = fs::file_size(path, ec);
+  if (ec) throw p.error("path", "cannot read '" + path.string() + "': " + ec.message());
+  if (size > kMaxFileBytes)
+    throw p.error("path", "'" + path.string() + "' is larger than 1 GiB; split the log into several files");
+  std::string text(static_cast<std::size_t>(size), '\0');
   if (!in.read(text.data(), static_cast<std::streamsize>(text.size())))
     throw p.error("path", "cannot read '" + path.string() + "'");
   return text;
+}
+
+// A cell of the file as a message may quote it: the offending token only, short, no control
+// characters (the file may not be a log at all).
+std::string token(std::string_view s) {
+  std::string t;
+  for (std::size_t i = 0; i < s.size() && i < 40; ++i) {
+    const unsigned char c = static_cast<unsigned char>(s[i]);
+    t += c < 0x20 || c == 0x7f ? '?' : static_cast<char>(c);
+  }
+  return s.size() > 40 ? t + "..." : t;
+}
+
+// Whether a header looks like column names (so that listing it quotes no content of a file
+// that is not a log, e.g. the first line of a system file).
+bool plausible_header(const std::vector<std::string>& names) {
+  if (names.empty() || names.size() > 256) return false;
+  for (const auto& n : names) {
+    if (n.empty() || n.size() > 64) return false;
+    for (char c : n)
+      if (!(std::isalnum(static_cast<unsigned char>(c)) || std::string_view(" _-.()[]/%#+").find(c) != std::string_view::npos))
+        return false;
+  }
+  return true;
+}
+
+// One data row as replayed: what varies between rows (the rest is the source's prototype
+// measurement). 56 bytes instead of a whole Measurement, so 2e6 rows take ~110 MB.
+struct Row {
+  double time = 0.0;
+  double value[4] = {};
+  double snr_db = 0.0;
+  std::uint32_t sensor = 0;
+  MeasMode mode = MeasMode::Unknown;
+  bool valid = true;
+  bool has_snr = false;
+};
+
+// The parsed file, shared read-only by every instance (one per worker thread, plus the one
+// that aggregates) built from the same file and parameters: parsed once, held once.
+struct ParsedLog {
+  std::vector<Row> rows;
+  std::vector<std::string> skipped;  // the first kMaxSkipMessages messages
+  std::size_t skipped_count = 0;
+  std::size_t rows_read = 0;
+};
+constexpr std::size_t kMaxSkipMessages = 1000;
+
+// Files parsed by this process, by path, file identity and parameters. Weak: a log is freed
+// with its last instance, except the latest one, kept so that `validate`'s build and the run's
+// instances share one parse.
+struct LogCache {
+  std::mutex mutex;
+  std::map<std::string, std::weak_ptr<const ParsedLog>> logs;
+  std::shared_ptr<const ParsedLog> latest;
+};
+LogCache& log_cache() {
+  static LogCache* cache = new LogCache();  // never destroyed: instances may outlive statics
+  return *cache;
+}
+
+std::string cache_key(const Params& p, const fs::path& path) {
+  std::error_code ec;
+  std::string key = path.string() + '\n' + fs::canonical(path, ec).string() + '\n';
+  const auto size = fs::file_size(path, ec);
+  const auto mtime = fs::last_write_time(path, ec);
+  key += std::to_string(size) + '\n' + std::to_string(mtime.time_since_epoch().count()) + '\n';
+  char buf[40];
+  for (const auto& [name, v] : p.values()) {
+    key += name + '=';
+    switch (v.type) {
+      case ParamType::Real: std::snprintf(buf, sizeof buf, "%.17g", v.real); key += buf; break;
+      case ParamType::Integer: key += std::to_string(v.integer); break;
+      case ParamType::Boolean: key += v.boolean ? "1" : "0"; break;
+      case ParamType::String: key += v.text; break;
+      case ParamType::Choice: key += std::to_string(v.choice); break;
+      case ParamType::RealList:
+        for (double x : v.reals) {
+          std::snprintf(buf, sizeof buf, "%.17g,", x);
+          key += buf;
+        }
+        break;
+      case ParamType::Records: break;
+    }
+    key += '\n';
+  }
+  return key;
 }
 
 class CsvSource final : public Generator {
@@ -82,30 +182,58 @@ class CsvSource final : public Generator {
     configure(p);
     const fs::path path = resolve_path(p);
     file_ = path.string();
-    const std::string text = read_file(p, path);
-    parse(text);
+    const std::string key = cache_key(p, path);
+    LogCache& cache = log_cache();
+    // Held while parsing: instances built at the same time wait for the one parse and share it.
+    std::lock_guard<std::mutex> lock(cache.mutex);
+    if (auto it = cache.logs.find(key); it != cache.logs.end()) log_ = it->second.lock();
+    if (!log_) {
+      auto parsed = std::make_shared<ParsedLog>();
+      building_ = parsed.get();
+      parse(read_file(p, path));
+      building_ = nullptr;
+      log_ = parsed;
+      for (auto it = cache.logs.begin(); it != cache.logs.end();)
+        it = it->second.expired() ? cache.logs.erase(it) : std::next(it);
+      cache.logs[key] = log_;
+    }
+    cache.latest = log_;
+    current_ = prototype_;
   }
 
   void start_run(const RunContext& ctx) override {
     cursor_ = 0;
-    // Every instance parses the same file; only run 0 reports, so each bad row is counted once.
-    if (ctx.run == 0 && ctx.diagnostics)
-      for (const auto& message : skipped_) ctx.diagnostics->skip(node_, message);
+    // Every instance replays the same rows; only run 0 reports, so each bad row is counted once.
+    if (ctx.run == 0 && ctx.diagnostics) {
+      for (const auto& message : log_->skipped) ctx.diagnostics->skip(node_, message);
+      if (log_->skipped_count > log_->skipped.size())
+        ctx.diagnostics->skip(node_, "... and " + std::to_string(log_->skipped_count - log_->skipped.size()) +
+                                         " more bad rows left out (all counted in skipped_rows)");
+    }
   }
 
   FrameMask produced_frames() const override { return mask(frame_); }
 
   double next_time() const override {
-    return cursor_ < items_.size() ? items_[cursor_].time : std::numeric_limits<double>::infinity();
+    return cursor_ < log_->rows.size() ? log_->rows[cursor_].time : std::numeric_limits<double>::infinity();
   }
 
   void emit_next() override {
-    if (cursor_ < items_.size()) out.emit(items_[cursor_++]);
+    if (cursor_ >= log_->rows.size()) return;
+    const Row& r = log_->rows[cursor_++];
+    current_.time = r.time;
+    for (int k = 0; k < current_.value.size(); ++k) current_.value(k) = r.value[k];
+    current_.snr_db = r.snr_db;
+    current_.has_snr = r.has_snr;
+    current_.mode = r.mode;
+    current_.valid = r.valid;
+    current_.sensor = r.sensor;
+    out.emit(current_);
   }
 
   void finish(Summary& s, const FinishContext&) override {
-    s.metric("rows", static_cast<double>(rows_));
-    s.metric("skipped_rows", static_cast<double>(skipped_.size()));
+    s.metric("rows", static_cast<double>(log_->rows_read));
+    s.metric("skipped_rows", static_cast<double>(log_->skipped_count));
   }
 
  private:
@@ -182,8 +310,12 @@ class CsvSource final : public Generator {
   // Finds every named column in the header; a missing one is fatal whatever on_bad_row says.
   void locate_columns(const csv::Line& header_line, const std::vector<std::string_view>& header) {
     std::vector<std::string> names(header.begin(), header.end());
-    std::string listing;
-    for (const auto& n : names) listing += (listing.empty() ? "" : ", ") + ("'" + n + "'");
+    const bool listable = plausible_header(names);
+    auto listing = [&] {
+      std::string l;
+      for (const auto& n : names) l += (l.empty() ? "" : ", ") + ("'" + n + "'");
+      return l;
+    };
     for (Column* c : {&time_, &value_[0], &value_[1], &value_[2], &range_rate_, &snr_, &mode_, &valid_, &sensor_}) {
       if (c->name.empty()) continue;
       int found = -1, count = 0;
@@ -192,10 +324,14 @@ class CsvSource final : public Generator {
           if (found < 0) found = static_cast<int>(i);
           ++count;
         }
-      if (count == 0)
+      if (count == 0) {
+        if (!listable)
+          fail(at(header_line.number) + "no column '" + c->name + "' (" + c->param +
+               "): the first line does not look like a header of column names (is 'path' the right file?)");
         fail(at(header_line.number) + "no column '" + c->name + "' (" + c->param + ") in the header" +
              csv::did_you_mean(c->name, names) + "; the header has " + std::to_string(names.size()) +
-             " column(s): " + listing + "; if the file names it differently, set " + c->param);
+             " column(s): " + listing() + "; if the file names it differently, set " + c->param);
+      }
       if (count > 1)
         fail(at(header_line.number) + "column '" + c->name + "' (" + c->param + ") appears " + std::to_string(count) +
              " times in the header; rename one so the source knows which to read");
@@ -205,13 +341,30 @@ class CsvSource final : public Generator {
   }
 
   void parse(const std::string& text) {
-    const std::vector<csv::Line> lines = csv::split_lines(text);
-    std::size_t first = 0, end = lines.size();
-    while (first < end && csv::is_blank(lines[first].text)) ++first;
-    while (end > first && csv::is_blank(lines[end - 1].text)) --end;  // blank lines at the end are fine
-    if (first == end) fail(file_ + ": the file is empty; expected a header row, then one row per measurement");
+    // Lines are taken one at a time (no table of 2e6 lines); blank lines after the last
+    // non-blank one are fine, so find where the content ends first.
+    std::size_t content_end = text.size();
+    for (;;) {
+      const std::size_t nl = content_end == 0 ? std::string::npos : text.rfind('\n', content_end - 1);
+      const std::size_t start = nl == std::string::npos ? 0 : nl + 1;
+      if (!csv::is_blank(std::string_view(text).substr(start, content_end - start))) break;
+      if (start == 0) {
+        content_end = 0;
+        break;
+      }
+      content_end = nl;  // drop this blank line (and its newline)
+    }
+    csv::LineReader reader(std::string_view(text).substr(0, content_end), text.size() > content_end);
+    csv::Line header_line;
+    // Leading blank lines are skipped.
+    bool have_header = false;
+    while (reader.next(header_line))
+      if (!csv::is_blank(header_line.text)) {
+        have_header = true;
+        break;
+      }
+    if (!have_header) fail(file_ + ": the file is empty; expected a header row, then one row per measurement");
 
-    const csv::Line& header_line = lines[first];
     std::vector<std::string_view> fields;
     if (std::string why = csv::split_fields(header_line.text, fields); !why.empty())
       fail(at(header_line.number) + "header: " + why);
@@ -223,25 +376,41 @@ class CsvSource final : public Generator {
     }
     locate_columns(header_line, fields);
     header_number_ = header_line.number;
-    if (first + 1 == end) fail(at(header_line.number) + "the file has a header but no data rows");
+    if (reader.done()) fail(at(header_line.number) + "the file has a header but no data rows");
 
-    items_.reserve(end - first - 1);
-    for (std::size_t i = first + 1; i < end; ++i) {
-      ++rows_;
-      Measurement m = prototype_;
-      std::string why = read_row(lines[i], i + 1 == end, fields, m);
+    ParsedLog& log = *building_;
+    log.rows.reserve(static_cast<std::size_t>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(content_end), '\n')) + 1);
+    csv::Line line;
+    Measurement m = prototype_;
+    while (reader.next(line)) {
+      ++log.rows_read;
+      const bool last = reader.done();
+      std::string why = read_row(line, last, fields, m);
       if (why.empty()) {
-        items_.push_back(m);
+        Row& r = log.rows.emplace_back();
+        r.time = m.time;
+        for (int k = 0; k < m.value.size() && k < 4; ++k) r.value[k] = m.value(k);
+        r.snr_db = m.snr_db;
+        r.has_snr = m.has_snr;
+        r.mode = m.mode;
+        r.valid = m.valid;
+        r.sensor = m.sensor;
         continue;
       }
-      why = at(lines[i].number) + why;
+      why = at(line.number) + why;
       if (!skip_bad_rows_) fail(why);
-      skipped_.push_back(std::move(why));
+      if (log.skipped.size() < kMaxSkipMessages) log.skipped.push_back(std::move(why));
+      ++log.skipped_count;
     }
   }
 
   // Fills `m` from one data line; returns what is wrong with the line, or "" if nothing.
   std::string read_row(const csv::Line& line, bool last, std::vector<std::string_view>& fields, Measurement& m) {
+    m.snr_db = prototype_.snr_db;
+    m.has_snr = prototype_.has_snr;
+    m.mode = prototype_.mode;
+    m.valid = prototype_.valid;
+    m.sensor = prototype_.sensor;
     const std::string truncated = last && !line.terminated ? "the last line looks truncated (no newline at the end of the file): " : "";
     if (csv::is_blank(line.text))
       return "empty line inside the data (expected " + std::to_string(field_count_) + " fields as in the header)";
@@ -256,7 +425,7 @@ class CsvSource final : public Generator {
 
     std::string problem;
     auto complain = [&](const std::string& what, const Column& c) {
-      problem = what + " (column " + c.name + ", value '" + std::string(fields[c.index]) + "')";
+      problem = what + " (column " + c.name + ", value '" + token(fields[c.index]) + "')";
     };
     // An empty or half-written cell on an unterminated last line is most likely a cut-off write.
     auto real = [&](const Column& c, double& v) {
@@ -273,7 +442,7 @@ class CsvSource final : public Generator {
     if (!real(time_, t)) return problem;
     t *= time_scale_;
     if (has_previous_ && t < previous_time_) {
-      complain("time goes backwards: earlier than " + std::string(previous_time_text_) + " on line " +
+      complain("time goes backwards: earlier than " + token(previous_time_text_) + " on line " +
                    std::to_string(previous_line_),
                time_);
       return problem;
@@ -283,6 +452,11 @@ class CsvSource final : public Generator {
       double v = 0.0;
       if (!real(value_[k], v)) return problem;
       m.value(k) = v * scale_[k];
+      // Finite in the file's unit is not enough: 1e306 km is infinite in metres.
+      if (!std::isfinite(m.value(k))) {
+        complain("value overflows when converted to SI", value_[k]);
+        return problem;
+      }
     }
     if (m.frame == Frame::Spherical) {
       if (m.value(0) < 0.0) {
@@ -299,6 +473,10 @@ class CsvSource final : public Generator {
       double v = 0.0;
       if (!real(range_rate_, v)) return problem;
       m.value(3) = v * rdot_scale_;
+      if (!std::isfinite(m.value(3))) {
+        complain("value overflows when converted to SI", range_rate_);
+        return problem;
+      }
     }
     if (snr_.read()) {
       if (!real(snr_, m.snr_db)) return problem;
@@ -342,9 +520,9 @@ class CsvSource final : public Generator {
   int previous_line_ = 0;
 
   // The replayed data.
-  std::vector<Measurement> items_;
-  std::vector<std::string> skipped_;
-  std::size_t rows_ = 0;
+  std::shared_ptr<const ParsedLog> log_;
+  ParsedLog* building_ = nullptr;  // while this instance parses
+  Measurement current_;            // the prototype with the fields of the row being emitted
   std::size_t cursor_ = 0;
   Frame frame_ = Frame::Spherical;
 };

@@ -53,6 +53,23 @@ std::vector<Line> split_lines(std::string_view text) {
   return lines;
 }
 
+bool LineReader::next(Line& line) {
+  if (pos_ >= text_.size()) return false;
+  const auto nl = text_.find('\n', pos_);
+  line.number = ++number_;
+  if (nl == std::string_view::npos) {
+    line.text = text_.substr(pos_);
+    line.terminated = last_terminated_;
+    pos_ = text_.size();
+  } else {
+    line.text = text_.substr(pos_, nl - pos_);
+    line.terminated = true;
+    pos_ = nl + 1;
+  }
+  if (!line.text.empty() && line.text.back() == '\r') line.text.remove_suffix(1);
+  return true;
+}
+
 bool is_blank(std::string_view s) { return trim(s).empty(); }
 
 std::string split_fields(std::string_view line, std::vector<std::string_view>& fields) {
@@ -118,9 +135,13 @@ bool iequals(std::string_view a, std::string_view b) {
 }
 
 std::string did_you_mean(std::string_view word, const std::vector<std::string>& candidates) {
+  // The distance is quadratic in the lengths: long words are no typos (and a huge header line
+  // must not cost minutes).
+  if (word.size() > 64) return {};
   const std::string* best = nullptr;
   std::size_t best_d = std::numeric_limits<std::size_t>::max();
   for (const auto& c : candidates) {
+    if (c.size() > 64) continue;
     const std::size_t d = edit_distance(word, c);
     if (d < best_d) {
       best_d = d;

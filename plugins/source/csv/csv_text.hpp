@@ -17,6 +17,22 @@ struct Line {
 // Every line of `text`, in order. A file ending with "\n" has no extra empty last line.
 std::vector<Line> split_lines(std::string_view text);
 
+// The lines of `text` one at a time, as split_lines numbers them, without a table of them all.
+// `text` must not end with a newline (cut it after the last line); `last_terminated` says
+// whether that last line had one in the file.
+class LineReader {
+ public:
+  LineReader(std::string_view text, bool last_terminated) : text_(text), last_terminated_(last_terminated) {}
+  bool next(Line& line);
+  bool done() const { return pos_ >= text_.size(); }
+
+ private:
+  std::string_view text_;
+  bool last_terminated_;
+  std::size_t pos_ = 0;
+  int number_ = 0;
+};
+
 bool is_blank(std::string_view s);
 
 // Splits at commas into `fields` (cleared first), trimming blanks and removing one pair of

@@ -3,6 +3,8 @@
 
 #include <catch2/catch.hpp>
 
+#include <sys/stat.h>
+
 #include "plugin_fixture.hpp"
 
 #include <atomic>
@@ -385,4 +387,58 @@ TEST_CASE("a relative path is relative to the pipeline file") {
   test::drain(*src);
   REQUIRE(out.measurements.size() == 1);
   CHECK(out.measurements[0].value(0) == 42);
+}
+
+// a file that is not a log: no line of it is quoted beyond the offending token
+TEST_CASE("a file that is not a log is not quoted") {
+  TempDir dir;
+  const std::string secret = "root:x:0:0:root:/root:/bin/bash";
+  const std::string message = data_error(dir, "passwd", secret + "\ndaemon:x:1:1::/usr/sbin:/usr/sbin/nologin\n");
+  CHECK_THAT(message, Catch::Matchers::Contains("does not look like a header"));
+  CHECK_THAT(message, !Catch::Matchers::Contains("root:x"));
+  CHECK_THAT(message, !Catch::Matchers::Contains("daemon"));
+  // A long cell is cut: the message never carries a whole line.
+  const std::string long_cell(5000, 'z');
+  const std::string cut = data_error(dir, "long.csv", "time,range,azimuth,elevation\n0," + long_cell + ",0,0\n");
+  CHECK_THAT(cut, Catch::Matchers::Contains("not a number"));
+  CHECK(cut.size() < 400);
+}
+
+// finite in the file's unit is not enough: the value must be finite in SI
+TEST_CASE("a value that overflows in SI is a bad row") {
+  TempDir dir;
+  const std::string message =
+      data_error(dir, "km.csv", "time,range,azimuth,elevation\n0,1e306,0,0\n", "range_unit: km");
+  CHECK_THAT(message, Catch::Matchers::Contains("km.csv:2: value overflows when converted to SI (column range"));
+  CHECK(data_error(dir, "km_ok.csv", "time,range,azimuth,elevation\n0,1e300,0,0\n", "range_unit: km").empty());
+}
+
+// only regular files are logs: a FIFO would block, a device never end
+TEST_CASE("a path that is not a regular file is refused") {
+  TempDir dir;
+  const std::string fifo = (dir.path() / "fifo.csv").string();
+  REQUIRE(::mkfifo(fifo.c_str(), 0600) == 0);
+  try {
+    (void)test::make("source.csv", yaml_params(fifo));
+    FAIL("a FIFO must be refused");
+  } catch (const ConfigError& e) {
+    CHECK_THAT(e.message(), Catch::Matchers::Contains("not a regular file"));
+  }
+}
+
+// many bad rows with on_bad_row: skip keep a bounded list of messages and an exact count
+TEST_CASE("many skipped rows keep a bounded message list") {
+  TempDir dir;
+  std::string text = "time,range,azimuth,elevation\n0,1,0,0\n";
+  for (int i = 1; i <= 3000; ++i) text += std::to_string(i) + ",abc,0,0\n";
+  const std::string file = dir.write("many.csv", text);
+  auto src = test::make("source.csv", yaml_params(file, "on_bad_row: skip"), "radar");
+  Diagnostics run0;
+  test::drain(*src, 1, 0, &run0);
+  CHECK(run0.skips.size() == 1001);
+  CHECK_THAT(run0.skips.back().message, Catch::Matchers::Contains("2000 more bad rows"));
+  Summary summary;
+  src->finish(summary, {"radar", "", 1});
+  CHECK(summary.find("skipped_rows")->value == 3000);
+  CHECK(summary.find("rows")->value == 3001);
 }

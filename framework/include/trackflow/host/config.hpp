@@ -3,6 +3,7 @@
 
 #include <trackflow/error.hpp>
 
+#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <optional>
@@ -27,7 +28,23 @@ struct Value {
   SourceLoc key_loc(const std::string& key) const;
   bool is_scalar() const { return kind == Kind::Scalar; }
   std::string describe() const;  // "a map", "a list", "'abc'"
+
+  // Out of line (config.cpp): inline ones would instantiate std::pair<std::string, Value>
+  // while Value is incomplete, which clang refuses.
+  Value();
+  Value(const Value&);
+  Value(Value&&) noexcept;
+  Value& operator=(const Value&);
+  Value& operator=(Value&&) noexcept;
+  ~Value();
 };
+
+// Limits on what a pipeline file may ask of the loader, so a hostile or broken file ends in a
+// clear error rather than exhausting memory or the stack (docs/pipeline-yaml.md, "Limits").
+inline constexpr std::size_t kMaxYamlBytes = 2u << 20;   // 2 MiB of YAML text
+inline constexpr std::size_t kMaxYamlValues = 250'000;   // values after alias expansion
+inline constexpr std::size_t kMaxYamlDepth = 64;         // nesting of lists and maps
+inline constexpr std::size_t kMaxNodes = 10'000;         // nodes in one pipeline
 
 Value load_yaml_file(const std::string& path);
 Value load_yaml_string(const std::string& text, const std::string& name);
@@ -64,8 +81,15 @@ struct PipelineConfig {
   std::uint64_t runs = 1;
   std::string on_bad_row = "error";
   std::vector<std::string> plugin_paths;  // resolved relative to the file
+  SourceLoc plugin_paths_loc;             // where the file asks for them (refused unless trusted)
   std::vector<NodeConfig> nodes;
   std::vector<ExpectConfig> expects;
+  // Top-level `sites:` (name -> {latitude, longitude, height}) as a list of records, each with its
+  // `name`; given to every node that declares a `sites` parameter (and does not set its own).
+  Value sites;
+  // `pipeline.frame_origin`: the site the pipeline's ENU frame is anchored at; given to every
+  // node that declares a `frame_origin` parameter. Empty: none.
+  Value frame_origin;
 };
 
 // A `--set node.param=value` override, applied to the tree before validation.

@@ -19,6 +19,7 @@ struct RegisteredType {
   std::shared_ptr<boost::dll::shared_library> library;
   ComponentDecl decl;
   std::string file;  // the .so it came from
+  bool builtin = false;  // from the installed (or build-tree) plugin folder
 };
 
 struct LoadedPlugin {
@@ -39,10 +40,13 @@ struct LoadProblem {
 class PluginRegistry {
  public:
   // Loads every file named tfplugin_*.so in each directory, in the order given. When two
-  // files declare the same type, the first one found wins and the other is a LoadProblem.
-  void load_directories(const std::vector<std::string>& dirs);
+  // files declare the same type, the first one found wins and the other is a LoadProblem --
+  // except that a type of a `builtin` folder loaded earlier is replaced by a later plugin when
+  // it was named in allow_replacing (the CLI's --replace-type).
+  void load_directories(const std::vector<std::string>& dirs, bool builtin = false);
   // Loads one file; problems are recorded, not thrown.
-  void load_file(const std::string& path);
+  void load_file(const std::string& path, bool builtin = false);
+  void allow_replacing(std::vector<std::string> types);
 
   const RegisteredType* find(const std::string& type) const;
   std::vector<std::string> type_names() const;
@@ -59,10 +63,15 @@ class PluginRegistry {
   std::vector<LoadedPlugin> plugins_;
   std::vector<LoadProblem> problems_;
   std::vector<std::string> searched_;
+  std::vector<std::string> replaceable_;
 };
 
-// Default search path after --plugin-path and the pipeline's plugin_paths:
-// $TRACKFLOW_PLUGIN_PATH (colon-separated), then <executable dir>/../lib/trackflow/plugins.
+// The installed (or build-tree) plugin folder: <executable dir>/../lib/trackflow/plugins and
+// <prefix>/<libdir>/trackflow/plugins. Its types are the built-in ones.
+std::vector<std::string> builtin_plugin_dirs();
+// $TRACKFLOW_PLUGIN_PATH, colon-separated.
+std::vector<std::string> environment_plugin_dirs();
+// $TRACKFLOW_PLUGIN_PATH, then the built-in folders (for tools that take everything).
 std::vector<std::string> default_plugin_dirs();
 
 }  // namespace trackflow::host

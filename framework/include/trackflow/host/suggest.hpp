@@ -1,7 +1,8 @@
-// Purpose: "did you mean" suggestions for misspelt names (parameters, types, node ids).
+// Purpose: "did you mean" suggestions for misspelt names (parameters, types, node ids), and words from files made safe to quote.
 #pragma once
 
 #include <string>
+#include <string_view>
 #include <vector>
 
 namespace trackflow::host {
@@ -10,5 +11,11 @@ std::size_t edit_distance(const std::string& a, const std::string& b);
 // " (did you mean 'x'?)" or "" when nothing is close.
 std::string did_you_mean(const std::string& word, const std::vector<std::string>& candidates);
 std::string join(const std::vector<std::string>& words, const std::string& sep = ", ");
+// The first `max` words joined, then "... (N more)": a message stays readable with 10 000 nodes.
+std::string join_some(const std::vector<std::string>& words, std::size_t max = 20);
+// A word from an analyst's or another party's file as it may appear in a message: at most `max`
+// bytes (then "..."), control characters as '?', so a message never carries more of a file
+// than the offending token, nor terminal escapes.
+std::string quote_token(std::string_view word, std::size_t max = 60);
 
 }  // namespace trackflow::host

@@ -3,10 +3,14 @@
 
 #include <trackflow/host/config.hpp>
 
+#include <cstddef>
 #include <string>
 #include <vector>
 
 namespace trackflow::host {
+
+// A grid larger than this is refused before any graph is built (docs/pipeline-yaml.md, "Limits").
+inline constexpr std::size_t kMaxSweepPoints = 10'000;
 
 struct SweepAxis {
   std::string node, param;

@@ -1,0 +1,180 @@
+// Purpose: test-only plugins that misbehave the way a buggy plugin can (test.misbehave: throws, crashes, aborts at a chosen item; test.nan_estimates: publishes NaN; test.nan_filter: a front-end filter whose state turns NaN), for tests/hostile.
+#include <trackflow/filter_front_end.hpp>
+#include <trackflow/plugin.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <limits>
+#include <stdexcept>
+
+namespace {
+
+using namespace trackflow;
+
+enum class What { None, ThrowStd, ThrowInt, ThrowData, Segfault, StackOverflow, Abort };
+
+// Deep recursion that no compiler can turn into a loop: every frame is used after the call.
+int recurse(int n) {
+  volatile char frame[4096];
+  frame[0] = static_cast<char>(n);
+  return recurse(n + 1) + frame[0];
+}
+
+// Passes measurements on; at measurement `at` of run `run` it does `what`.
+class Misbehave final : public Component {
+ public:
+  explicit Misbehave(const Params& p)
+      : what_(p.choice<What>("what")), at_(p.integer("at")), run_wanted_(static_cast<std::uint64_t>(p.integer("run"))) {}
+
+  void start_run(const RunContext& ctx) override {
+    run_ = ctx.run;
+    count_ = 0;
+  }
+
+  void on_measurement(const Measurement& m, int) override {
+    if (run_ == run_wanted_ && count_++ == at_) misbehave();
+    out.emit(m);
+  }
+
+ private:
+  void misbehave() const {
+    switch (what_) {
+      case What::None: return;
+      case What::ThrowStd: throw std::out_of_range("index 7 out of range (deliberate)");
+      case What::ThrowInt: throw 42;
+      case What::ThrowData: throw DataError("a deliberate data error");
+      case What::Segfault: {
+        // Not null: a null store is caught by UBSan before it faults; page 0 faults in any build.
+        static volatile std::uintptr_t address = 16;
+        *reinterpret_cast<volatile int*>(address) = 1;
+        return;
+      }
+      case What::StackOverflow: (void)recurse(0); return;
+      case What::Abort: std::abort();
+    }
+  }
+
+  const What what_;
+  const long long at_;
+  const std::uint64_t run_wanted_;
+  std::uint64_t run_ = 0;
+  long long count_ = 0;
+};
+
+// A filter outside the front end that publishes the measured position as its state, NaN from
+// measurement `at` on: what reaches a sink when a plugin lets a NaN through.
+class NanEstimates final : public Filter {
+ public:
+  explicit NanEstimates(const Params& p) : at_(p.integer("at")) {}
+  void start_run(const RunContext&) override { count_ = 0; }
+  void on_measurement(const Measurement& m, int) override {
+    Estimate e;
+    e.time = m.time;
+    e.initialised = true;
+    e.updated = false;
+    e.state = StateVec::Zero(6);
+    e.covariance = StateCov::Identity(6, 6);
+    e.enu.setZero();
+    e.enu.head<3>() = m.value.head<3>();
+    e.enu_covariance = Mat6::Identity();
+    if (count_++ >= at_) e.enu(0) = std::numeric_limits<double>::quiet_NaN();
+    publish(m, e);
+  }
+
+ private:
+  const long long at_;
+  long long count_ = 0;
+};
+
+// A filter through the SDK front end whose state becomes NaN at the update at time `at`: the
+// front end must refuse that step instead of publishing it.
+class NanFilter final : public FilterFrontEnd<NanFilter> {
+  friend FilterFrontEnd<NanFilter>;
+
+ public:
+  NanFilter(const Params& p)
+      : FilterFrontEnd(FrontEndSpec{"test.nan_filter", p.node(), Frame::Cartesian, RangeRateUse::Ignore, {}}),
+        at_(p.real("at")) {
+    est_.state.resize(6);
+    est_.covariance.resize(6, 6);
+  }
+  NoiseHandles noise() override { return {}; }
+
+ private:
+  bool reset_track() { return false; }
+  bool initialise(const Measurement& m, int) {
+    x_ = m.value.head<3>();
+    return true;
+  }
+  void predict(double) {}
+  template <int M>
+  bool update(const Measurement& m) {
+    x_ = m.value.head<3>();
+    if (std::abs(m.time - at_) < 1e-9) x_(1) = std::numeric_limits<double>::quiet_NaN();
+    return true;
+  }
+  void fill_estimate(Estimate& e) const {
+    e.state.setZero();
+    e.state.head<3>() = x_;
+    e.covariance.setIdentity();
+    e.enu.setZero();
+    e.enu.head<3>() = x_;
+    e.enu_covariance.setIdentity();
+  }
+  void scale_state_covariance(double) {}
+
+  const double at_;
+  Vec3 x_ = Vec3::Zero();
+};
+
+void register_components(Registrar& r) {
+  ComponentDecl d;
+  d.type = "test.misbehave";
+  d.kind = ComponentKind::Converter;
+  d.summary = "Test only: passes measurements on and misbehaves (throws, crashes, aborts) at a chosen one";
+  d.params = {
+      ParamSpec::choice<What>("what",
+                              {{What::None, "none"},
+                               {What::ThrowStd, "throw_std"},
+                               {What::ThrowInt, "throw_int"},
+                               {What::ThrowData, "throw_data"},
+                               {What::Segfault, "segfault"},
+                               {What::StackOverflow, "stack_overflow"},
+                               {What::Abort, "abort"}},
+                              "what to do")
+          .def("none"),
+      ParamSpec::integer("at", "0-based index of the measurement of the run at which to misbehave").def("3"),
+      ParamSpec::integer("run", "the run in which to misbehave").def("0"),
+  };
+  d.accepts = mask(ItemKind::Measurement);
+  d.produces = mask(ItemKind::Measurement);
+  d.create = [](const Params& p) -> std::unique_ptr<Component> { return std::make_unique<Misbehave>(p); };
+  r.add(d);
+
+  ComponentDecl n;
+  n.type = "test.nan_estimates";
+  n.kind = ComponentKind::Filter;
+  n.summary = "Test only: publishes the measured position as its estimate, NaN from measurement `at` on";
+  n.params = {ParamSpec::integer("at", "0-based index of the first NaN estimate").def("2")};
+  n.accepts = mask(ItemKind::Measurement);
+  n.accepts_frames = mask(Frame::Cartesian);
+  n.produces = mask(ItemKind::Estimate);
+  n.create = [](const Params& p) -> std::unique_ptr<Component> { return std::make_unique<NanEstimates>(p); };
+  r.add(n);
+
+  ComponentDecl f;
+  f.type = "test.nan_filter";
+  f.kind = ComponentKind::Filter;
+  f.summary = "Test only: a front-end filter whose state turns NaN at the update at time `at`";
+  f.params = {ParamSpec::real("at", dim::time, "time of the update that produces NaN").def("0.5 s")};
+  f.accepts = mask(ItemKind::Measurement);
+  f.accepts_frames = mask(Frame::Cartesian);
+  f.produces = mask(ItemKind::Estimate);
+  f.create = [](const Params& p) -> std::unique_ptr<Component> { return std::make_unique<NanFilter>(p); };
+  r.add(f);
+}
+
+}  // namespace
+
+TRACKFLOW_PLUGIN("test.misbehave", register_components)
