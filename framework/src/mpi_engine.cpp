@@ -1,4 +1,5 @@
 // Purpose: the Monte Carlo ensemble across the processes of an MPI job (Open MPI through Boost.MPI): rank 0 hands out runs in order, every process runs them on its threads, results come back as bytes and are merged in run order on rank 0.
+#include <trackflow/host/guard.hpp>
 #include <trackflow/host/mpi.hpp>
 #include <trackflow/rng.hpp>
 #include <trackflow/run_result_codec.hpp>
@@ -263,6 +264,9 @@ Outcome worker_rank(const Graph& g, const PluginRegistry& registry, const RunOpt
   std::deque<std::pair<int, std::string>> outbox;  // (tag, payload)
   bool shutdown = false;
   auto worker = [&]() {
+    // As in engine.cpp: a sink that keeps a large run's rows in a temporary file asks
+    // output_directory() (none there, or none possible: they stay in memory).
+    OutputDirectoryScope dir(opt.output_dir);
     std::unique_ptr<Runner> runner;
     std::string setup_error;
     try {
@@ -353,6 +357,9 @@ Outcome root_rank(const Graph& g, const PluginRegistry& registry, const RunOptio
   const std::uint64_t runs = opt.runs;
   Outcome out = empty_outcome(g, runs);
   GraphInstance aggregate = instantiate(g, registry);
+  // Results received from the other processes are loaded and merged on this thread, and finish()
+  // runs here: streaming sinks (sink.csv) write into --out as they merge, as in engine.cpp.
+  OutputDirectoryScope dir(opt.output_dir);
 
   // Handing out runs: in order, to whoever asks (its own threads and the other processes).
   std::mutex dispense_mutex;
@@ -407,6 +414,7 @@ Outcome root_rank(const Graph& g, const PluginRegistry& registry, const RunOptio
 
   std::atomic<unsigned> active{threads};
   auto worker = [&]() {
+    OutputDirectoryScope dir(opt.output_dir);  // merges happen here too: sink.csv streams its file
     try {
       Runner runner(g, registry, opt);
       for (;;) {

@@ -1,10 +1,11 @@
 #!/usr/bin/env bash
-# Purpose: an MPI job (mpirun --oversubscribe -np 3, threads per process) gives byte-identical outputs to one process with --threads 1 — metrics JSON, summary, series CSV, report series and track, sweep table — and a failing run stops the job naming the rank and the run.
+# Purpose: an MPI job (mpirun --oversubscribe -np 3, threads per process) gives byte-identical outputs to one process with --threads 1 — metrics JSON, summary, series CSV, report series and track, sweep table — for EVERY pipeline in pipelines/ (so a plugin added later without RunResultCodec fails here: the MPI engine refuses it) and for sink.csv with runs large enough to spill, and a failing run stops the job naming the rank and the run.
 # Skipped (exit 77) when this trackflow was built without MPI or mpirun is not installed.
 set -u
 TF=$1
 PLUGINS=$2
 DATA=$3
+ROOT=$4
 source "$(dirname "$0")/lib.sh"
 
 "$TF" --version | grep -q "MPI" || { echo "skipped: trackflow built without MPI"; exit 77; }
@@ -73,16 +74,70 @@ n=$("${MPIRUN[@]}" "$TF" run bad.yaml --no-progress 2>&1 | grep -c "unknown type
 [ "$n" -eq 1 ] || fail "the error was printed $n times"
 checks=$((checks + 1)); echo "ok: printed once"
 
-# sink.csv: its per-run rows cannot cross processes until its plugin implements RunResultCodec;
-# until then the job refuses it by name. Once it does, its file must be byte-identical.
+# sink.csv: each run's rows cross the processes as bytes (RunResultCodec); the file is identical.
 D="$DATA/determinism.yaml"
-if "${MPIRUN[@]}" "$TF" run "$D" --no-progress --out cjob > cjob.log 2>&1; then
-  "$TF" run "$D" --no-progress --out cone > cone.log 2>&1 || fail "determinism.yaml, one process"
-  cmp cone/tracks.csv cjob/tracks.csv || fail "sink.csv output differs under mpirun"
-  checks=$((checks + 1)); echo "ok: sink.csv byte-identical under mpirun"
-else
-  grep -q "node 'tracks' (sink.csv) returns per-run results that cannot be sent between the processes" cjob.log ||
-    fail "sink.csv under mpirun: $(cat cjob.log)"
-  checks=$((checks + 1)); echo "ok: sink.csv (no RunResultCodec yet) refused by name under mpirun"
-fi
+"$TF" run "$D" --no-progress --out cone > cone.log 2>&1 || fail "determinism.yaml, one process: $(cat cone.log)"
+"${MPIRUN[@]}" "$TF" run "$D" --threads 2 --no-progress --out cjob > cjob.log 2>&1 || fail "sink.csv under mpirun: $(cat cjob.log)"
+cmp cone/tracks.csv cjob/tracks.csv || fail "sink.csv output differs under mpirun"
+checks=$((checks + 1)); echo "ok: sink.csv byte-identical under mpirun"
+# Runs of ~6 MB of rows each: spilled to a temporary file where they run and again where rank 0
+# receives them (not held in memory while they wait to be merged in run order).
+L="$DATA/mpi_csv_large.yaml"
+"$TF" run "$L" --no-progress --out lone --metrics-json lone.json > lone.log 2>&1 || fail "mpi_csv_large.yaml, one process: $(cat lone.log)"
+"${MPIRUN[@]}" "$TF" run "$L" --no-progress --out ljob --metrics-json ljob.json > ljob.log 2>&1 ||
+  fail "mpi_csv_large.yaml under mpirun: $(cat ljob.log)"
+[ "$(stat -c %s lone/rows.csv)" -gt $((4 * 9 * 1024 * 1024 / 2)) ] || fail "mpi_csv_large.yaml: runs too small to spill ($(stat -c %s lone/rows.csv) bytes)"
+cmp lone/rows.csv ljob/rows.csv || fail "sink.csv output of large runs differs under mpirun"
+cmp lone.json ljob.json || fail "metrics JSON of mpi_csv_large.yaml differs under mpirun"
+[ -z "$(ls -A ljob | grep -v '^rows.csv$')" ] || fail "temporary files left in the output folder: $(ls -A ljob)"
+checks=$((checks + 1)); echo "ok: sink.csv with spilled runs ($(stat -c %s lone/rows.csv) bytes) byte-identical under mpirun"
+
+# Every pipeline of the repository, with fewer runs (at least 4, so that runs of every process
+# are merged on rank 0): exit code, summary, metrics JSON and every file under --out (series CSV,
+# sink files) identical. A node whose plugin lacks RunResultCodec makes the MPI job refuse the
+# pipeline, so a plugin added later without it fails here.
+# mpirun's own report of a process that exited non-zero: blocks between lines of dashes.
+without_mpirun() { awk '/^-----+$/ { skip = !skip; next } !skip' "$1"; }
+runs_for() {
+  case "$1" in
+    launch_normal_noise | shot_noise | worst_noise | beacon_skin) echo 4 ;;  # long runs (8 000-21 600 steps)
+    *) echo 5 ;;
+  esac
+}
+n=0
+for P in "$ROOT"/pipelines/*.yaml; do
+  name=$(basename "$P" .yaml)
+  R=$(runs_for "$name")
+  "$TF" run "$P" --runs "$R" --threads 1 --no-progress --series --out "pone/$name" --metrics-json "pone/$name.json" \
+    > "pone-$name.log" 2> "pone-$name.err"
+  rc_one=$?
+  "${MPIRUN[@]}" "$TF" run "$P" --runs "$R" --threads 1 --no-progress --series --out "pjob/$name" \
+    --metrics-json "pjob/$name.json" > "pjob-$name.log" 2> "pjob-$name.err"
+  rc_job=$?
+  # With fewer runs some expect checks fail (exit 1): they must fail alike.
+  [ "$rc_one" -le 1 ] || fail "$name, one process: exit $rc_one: $(cat "pone-$name.log" "pone-$name.err")"
+  [ "$rc_job" -eq "$rc_one" ] ||
+    fail "$name under mpirun: exit $rc_job, one process $rc_one: $(cat "pjob-$name.log" "pjob-$name.err")"
+  grep -q "runs shared by 3 MPI processes" "pjob-$name.log" || fail "$name did not run as 3 processes: $(cat "pjob-$name.log")"
+  cmp "pone/$name.json" "pjob/$name.json" || fail "$name: metrics JSON differs under mpirun"
+  diff <(summary "pone-$name.log") <(summary "pjob-$name.log") || fail "$name: summary differs under mpirun"
+  diff <(without_mpirun "pone-$name.err") <(without_mpirun "pjob-$name.err") || fail "$name: stderr differs under mpirun"
+  diff -r "pone/$name" "pjob/$name" > /dev/null || fail "$name: files under --out differ: $(diff -rq "pone/$name" "pjob/$name")"
+  n=$((n + 1))
+done
+[ "$n" -ge 10 ] || fail "only $n pipelines found in $ROOT/pipelines"
+checks=$((checks + 1)); echo "ok: all $n pipelines identical under mpirun -np 3 (summary, metrics JSON, files under --out)"
+
+# A sweep of another pipeline (refraction: sim.radar's counters, convert.clark_elevation,
+# filter.refraction_ekf, sink.elevation_error), with its per-point files.
+S=("$ROOT/pipelines/refraction_bias_estimation.yaml" --param "radar.n0=300,312.5" --runs 4
+   --metric ekf_error.max_error --metric clark.corrected --metric radar.refraction_invalid)
+"$TF" sweep "${S[@]}" --csv rone.csv --out rsone > rsone.log 2>&1 || fail "refraction sweep, one process: $(cat rsone.log)"
+"${MPIRUN[@]}" "$TF" sweep "${S[@]}" --csv rjob.csv --out rsjob > rsjob.log 2>&1 || fail "refraction sweep under mpirun: $(cat rsjob.log)"
+cmp rone.csv rjob.csv || fail "refraction sweep CSV differs"
+diff <(grep -v '^wrote' rsone.log) <(grep -v '^wrote' rsjob.log) || fail "refraction sweep table differs"
+# This pipeline's sinks write no files; if one ever does, they must match as well.
+if [ -e rsone ] || [ -e rsjob ]; then diff -r rsone rsjob > /dev/null || fail "refraction sweep files differ: $(diff -rq rsone rsjob)"; fi
+[ "$(wc -l < rone.csv)" -eq 3 ] || fail "refraction sweep: expected a header and 2 rows: $(cat rone.csv)"
+checks=$((checks + 1)); echo "ok: refraction sweep table and CSV identical under mpirun"
 finish

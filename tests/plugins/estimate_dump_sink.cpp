@@ -1,5 +1,6 @@
 // Purpose: test.estimate_dump — a test-only sink that writes a filter's full published output (state, state covariance, innovation, NIS, annotations) at 17 significant digits, for the reference-output regression test (tests/reference).
 #include <trackflow/plugin.hpp>
+#include <trackflow/run_result_codec.hpp>
 
 #include <cerrno>
 #include <cstdio>
@@ -20,7 +21,7 @@ struct DumpRunResult final : RunResult {
 // Rows of a run are kept for its first `head` estimates and then every `every`-th one (the
 // errors of a filter propagate to later steps, so sampled rows still see any change), for runs
 // below `runs`. Values are "%.17g": a double survives the round trip exactly.
-class EstimateDump final : public Component {
+class EstimateDump final : public Component, public RunResultCodec {
  public:
   explicit EstimateDump(const Params& p)
       : head_(p.integer("head")), every_(p.integer("every")), runs_(p.integer("runs")) {
@@ -64,6 +65,16 @@ class EstimateDump final : public Component {
     auto r = std::make_unique<DumpRunResult>();
     r->rows = std::move(rows_);
     rows_.clear();
+    return r;
+  }
+
+  // The run's rows cross processes under mpirun (run_result_codec.hpp).
+  void save_run_result(const RunResult& r, ByteWriter& out) const override {
+    out.put_string(static_cast<const DumpRunResult&>(r).rows);
+  }
+  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override {
+    auto r = std::make_unique<DumpRunResult>();
+    r->rows = in.get_string();
     return r;
   }
 

@@ -143,6 +143,7 @@ class QualitySwitchAdapter final : public Adapter, public RunResultCodec {
     out.put(r.ungraded);
     out.put(r.table_steps);
     out.put(r.graded);
+    out.put(r.graded_in);
     out.put(r.rms_sum);
     out.put(r.rms_count);
   }
@@ -155,6 +156,7 @@ class QualitySwitchAdapter final : public Adapter, public RunResultCodec {
     in.get(r->ungraded);
     in.get(r->table_steps);
     in.get(r->graded);
+    in.get(r->graded_in);
     in.get(r->rms_sum);
     in.get(r->rms_count);
     return r;

@@ -2,6 +2,7 @@
 #include "range_law.hpp"
 
 #include <trackflow/plugin.hpp>
+#include <trackflow/run_result_codec.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -23,7 +24,7 @@ struct RangeRRunResult final : RunResult {
 // R): the azimuth and elevation variances become R(r) at the measured range (paper 003 assumes range is
 // tracked perfectly, so the measurement's range is the range), their correlations with the other
 // channels are removed; range and range-rate entries stay the measurement's own.
-class RangeRAdapter final : public Adapter {
+class RangeRAdapter final : public Adapter, public RunResultCodec {
  public:
   explicit RangeRAdapter(RangeLaw law) : law_(law) {}
 
@@ -60,6 +61,27 @@ class RangeRAdapter final : public Adapter {
   }
 
   std::unique_ptr<RunResult> end_run() override { return std::make_unique<RangeRRunResult>(run_); }
+
+  // The run's sums cross processes under mpirun, bit for bit (run_result_codec.hpp).
+  void save_run_result(const RunResult& result, ByteWriter& out) const override {
+    const auto& r = static_cast<const RangeRRunResult&>(result);
+    out.put(r.sum);
+    out.put(r.thermal_sum);
+    out.put(r.min);
+    out.put(r.max);
+    out.put(r.adapted);
+    out.put(r.skipped);
+  }
+  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override {
+    auto r = std::make_unique<RangeRRunResult>();
+    in.get(r->sum);
+    in.get(r->thermal_sum);
+    in.get(r->min);
+    in.get(r->max);
+    in.get(r->adapted);
+    in.get(r->skipped);
+    return r;
+  }
 
   void merge(RunResult& result) override {
     const auto& r = static_cast<const RangeRRunResult&>(result);

@@ -2,6 +2,7 @@
 #include "../../sim/common/refraction.hpp"
 
 #include <trackflow/plugin.hpp>
+#include <trackflow/run_result_codec.hpp>
 
 #include <cmath>
 #include <cstdint>
@@ -25,7 +26,7 @@ struct ClarkRunResult final : RunResult {
 // measured point, 1 / (1 + b'(theta_c)) when solved). Below 2 deg clark_below_2deg decides:
 // invalid passes the measurement on with valid = false (counted; filters coast), hold uses b(2 deg),
 // extrapolate the 2-10 deg formula. Invalid measurements pass through untouched.
-class ClarkElevation final : public Component {
+class ClarkElevation final : public Component, public RunResultCodec {
  public:
   ClarkElevation(sim::ClarkModel model, EvaluateAt at, int iterations)
       : model_(model), at_(at), iterations_(iterations) {}
@@ -61,6 +62,18 @@ class ClarkElevation final : public Component {
   }
 
   std::unique_ptr<RunResult> end_run() override { return std::make_unique<ClarkRunResult>(run_); }
+  // The run's counts cross processes under mpirun (run_result_codec.hpp).
+  void save_run_result(const RunResult& result, ByteWriter& out) const override {
+    const auto& c = static_cast<const ClarkRunResult&>(result);
+    out.put(c.corrected);
+    out.put(c.invalid);
+  }
+  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override {
+    auto c = std::make_unique<ClarkRunResult>();
+    in.get(c->corrected);
+    in.get(c->invalid);
+    return c;
+  }
   void merge(RunResult& r) override {
     const auto& c = static_cast<ClarkRunResult&>(r);
     total_.corrected += c.corrected;

@@ -8,6 +8,7 @@
 #include <trackflow/common_params.hpp>
 #include <trackflow/geometry.hpp>
 #include <trackflow/plugin.hpp>
+#include <trackflow/run_result_codec.hpp>
 #include <trackflow/rng.hpp>
 
 #include <cmath>
@@ -33,7 +34,7 @@ struct MonopulseRunResult final : RunResult {
 // draws of the others unchanged: an ablation compares the same realisations.
 enum Stream : std::uint64_t { kRangeStream = 1, kRcsStream = 2, kGlintStream = 3, kThermalStream = 4 };
 
-class MonopulseRadar final : public Component {
+class MonopulseRadar final : public Component, public RunResultCodec {
  public:
   explicit MonopulseRadar(const Params& p)
       : node_(p.node()),
@@ -227,6 +228,17 @@ class MonopulseRadar final : public Component {
   std::unique_ptr<RunResult> end_run() override {
     auto r = std::make_unique<MonopulseRunResult>();
     r->stats = run_;
+    return r;
+  }
+
+  // The run's sums cross processes under mpirun as the struct's bytes (plain numbers, same build on
+  // every process: run_result_codec.hpp), so a field added later travels without a change here.
+  void save_run_result(const RunResult& result, ByteWriter& out) const override {
+    out.put(static_cast<const MonopulseRunResult&>(result).stats);
+  }
+  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override {
+    auto r = std::make_unique<MonopulseRunResult>();
+    in.get(r->stats);
     return r;
   }
 

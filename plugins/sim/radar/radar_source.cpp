@@ -8,6 +8,7 @@
 #include <trackflow/common_params.hpp>
 #include <trackflow/geometry.hpp>
 #include <trackflow/plugin.hpp>
+#include <trackflow/run_result_codec.hpp>
 #include <trackflow/rng.hpp>
 
 #include <algorithm>
@@ -72,7 +73,7 @@ void check_shot_params(const Params& p, const sim::ShotNoise& shot) {
 // The reported covariance is diag σ² of the σ's this look used, except that a shot-noise
 // burst is not in it (the radar does not know); the biases are a systematic error the
 // downstream filter is not told about.
-class RadarSource final : public Component {
+class RadarSource final : public Component, public RunResultCodec {
  public:
   explicit RadarSource(const Params& p)
       : node_(p.node()),
@@ -161,6 +162,15 @@ class RadarSource final : public Component {
     if (refraction_.kind == sim::RefractionKind::None) return nullptr;
     auto r = std::make_unique<RadarRunResult>();
     r->refraction_invalid = refraction_invalid_;
+    return r;
+  }
+  // The refraction counter crosses processes under mpirun (run_result_codec.hpp).
+  void save_run_result(const RunResult& result, ByteWriter& out) const override {
+    out.put(static_cast<const RadarRunResult&>(result).refraction_invalid);
+  }
+  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override {
+    auto r = std::make_unique<RadarRunResult>();
+    in.get(r->refraction_invalid);
     return r;
   }
   void merge(RunResult& r) override { total_refraction_invalid_ += static_cast<RadarRunResult&>(r).refraction_invalid; }

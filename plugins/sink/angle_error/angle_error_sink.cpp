@@ -6,6 +6,7 @@
 #include <trackflow/error.hpp>
 #include <trackflow/geometry.hpp>
 #include <trackflow/plugin.hpp>
+#include <trackflow/run_result_codec.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -33,7 +34,7 @@ struct AngleRunResult final : RunResult {
 // Items are kept during the run (capacity reused, so nothing is allocated once the first run has
 // sized the buffers) and scored in end_run(): the truth and the radar's position are known by then,
 // whatever order the pipeline delivers them in.
-class AngleErrorSink final : public Component {
+class AngleErrorSink final : public Component, public RunResultCodec {
  public:
   AngleErrorSink(std::vector<Interval> intervals, std::optional<Vec3> radar, AzimuthConvention convention, double tolerance)
       : intervals_(std::move(intervals)), radar_(radar), convention_(convention), tolerance_(tolerance) {
@@ -139,6 +140,29 @@ class AngleErrorSink final : public Component {
       for (size_t k = 0; k < intervals_.size(); ++k)
         if (intervals_[k].contains(it.time)) r->table.at(k, static_cast<size_t>(it.slot)).add(e_az, e_el);
     }
+    return r;
+  }
+
+  // The run's interval sums and counts cross processes under mpirun, bit for bit
+  // (run_result_codec.hpp); the receiving instance has the same intervals and inputs.
+  void save_run_result(const RunResult& result, ByteWriter& out) const override {
+    const auto& r = static_cast<const AngleRunResult&>(result);
+    out.put_vector(r.table.sums());
+    out.put_vector(r.missed);
+    out.put_vector(r.non_finite);
+    out.put(r.unmatched);
+  }
+  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override {
+    auto r = std::make_unique<AngleRunResult>();
+    r->table = IntervalTable(intervals_.size(), sources_.size());
+    const std::size_t cells = r->table.sums().size();
+    in.get_vector(r->table.sums());
+    in.get_vector(r->missed);
+    in.get_vector(r->non_finite);
+    in.get(r->unmatched);
+    if (r->table.sums().size() != cells || r->missed.size() != sources_.size() ||
+        r->non_finite.size() != sources_.size())
+      throw DataError("sink.angle_error: a run's result from another process has another table size");
     return r;
   }
 

@@ -55,6 +55,9 @@ class IntervalTable {
   void clear() {
     for (auto& s : sums_) s = ErrorSums{};
   }
+  // The flat table itself, for sending a run's table between processes (mpirun).
+  std::vector<ErrorSums>& sums() { return sums_; }
+  const std::vector<ErrorSums>& sums() const { return sums_; }
 
  private:
   std::size_t sources_ = 0;

@@ -4,6 +4,7 @@
 #include <trackflow/geometry.hpp>
 #include <trackflow/output_path.hpp>
 #include <trackflow/plugin.hpp>
+#include <trackflow/run_result_codec.hpp>
 
 #include <unistd.h>
 
@@ -80,6 +81,29 @@ struct PendingRow {
 // output, so a 10^6-step run never holds its whole text.
 constexpr std::size_t kSpillBytes = std::size_t{4} << 20;
 
+// A new anonymous temporary file in `dir` (created if missing), or null when none can be made
+// there (the rows then stay in memory).
+std::unique_ptr<TempFile> make_spill_file(const std::string& dir, const std::string& node) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  std::string pattern = (fs::path(dir) / ("." + node + ".run-XXXXXX")).string();
+  const int fd = ::mkstemp(pattern.data());
+  if (fd < 0) return nullptr;
+  ::unlink(pattern.c_str());
+  auto spill = std::make_unique<TempFile>();
+  spill->f = ::fdopen(fd, "w+b");
+  if (!spill->f) {
+    ::close(fd);
+    return nullptr;
+  }
+  return spill;
+}
+
+// Under mpirun a run's rows travel as chunks of at most this size (the spill file is read
+// back this much at a time), ended by an empty chunk.
+constexpr std::size_t kChunkBytes = std::size_t{1} << 20;
+
 std::string column_name(int column, const std::vector<std::string>& annotation_columns, bool full_covariance) {
   std::string header = kHeader;
   if (full_covariance) header += kCovarianceHeader;
@@ -95,7 +119,7 @@ std::string column_name(int column, const std::vector<std::string>& annotation_c
   }
 }
 
-class CsvSink final : public Component {
+class CsvSink final : public Component, public RunResultCodec {
  public:
   explicit CsvSink(const Params& p)
       : path_(p.has("path") ? p.text("path") : std::string()),
@@ -228,6 +252,51 @@ class CsvSink final : public Component {
     return r;
   }
 
+  // A run's rows cross processes under mpirun as the exact bytes it would have appended to the
+  // file (spilled part first, then the rest), so the merged file is byte-identical. The sender
+  // holds one run's text in its message; the receiver (rank 0, where finished runs may wait for
+  // an earlier one) moves the rows of a large run to a temporary file again, so waiting runs
+  // do not pile up in memory.
+  void save_run_result(const RunResult& result, ByteWriter& out) const override {
+    const auto& r = static_cast<const CsvRunResult&>(result);
+    out.put(r.count);
+    out.put(r.non_finite);
+    out.put_string(r.first_non_finite);
+    if (r.spilled) {
+      std::FILE* f = r.spilled->f;
+      std::rewind(f);
+      std::string chunk(kChunkBytes, '\0');
+      for (std::size_t n; (n = std::fread(chunk.data(), 1, chunk.size(), f)) > 0;) {
+        chunk.resize(n);
+        out.put_string(chunk);
+        chunk.resize(kChunkBytes);
+      }
+      if (std::ferror(f)) throw DataError("sink.csv (node '" + node_ + "'): cannot read back its temporary file");
+    }
+    for (std::size_t at = 0; at < r.rows.size(); at += kChunkBytes)
+      out.put_string(r.rows.substr(at, kChunkBytes));
+    out.put_string(std::string());
+  }
+  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override {
+    auto r = std::make_unique<CsvRunResult>();
+    in.get(r->count);
+    in.get(r->non_finite);
+    r->first_non_finite = in.get_string();
+    for (;;) {
+      const std::string chunk = in.get_string();
+      if (chunk.empty()) break;
+      r->rows += chunk;
+      if (r->rows.size() < kSpillBytes || output_directory().empty()) continue;
+      if (!r->spilled) r->spilled = make_spill_file(output_directory(), node_);
+      if (!r->spilled) continue;  // no temporary file possible: stays in memory
+      if (std::fwrite(r->rows.data(), 1, r->rows.size(), r->spilled->f) != r->rows.size())
+        throw ConfigError(std::string("cannot write a temporary file in the output folder: ") + std::strerror(errno),
+                          path_where_, node_);
+      r->rows.clear();
+    }
+    return r;
+  }
+
   void merge(RunResult& result) override {
     auto& r = static_cast<CsvRunResult&>(result);
     total_rows_ += r.count;
@@ -324,22 +393,8 @@ class CsvSink final : public Component {
   // memory. Without an output folder (a component used directly) they stay in memory.
   void maybe_spill() {
     if (rows_.size() < kSpillBytes || output_directory().empty()) return;
-    if (!spill_) {
-      namespace fs = std::filesystem;
-      std::error_code ec;
-      fs::create_directories(output_directory(), ec);
-      std::string pattern = (fs::path(output_directory()) / ("." + node_ + ".run-XXXXXX")).string();
-      const int fd = ::mkstemp(pattern.data());
-      if (fd < 0) return;  // stays in memory
-      ::unlink(pattern.c_str());
-      spill_ = std::make_unique<TempFile>();
-      spill_->f = ::fdopen(fd, "w+b");
-      if (!spill_->f) {
-        ::close(fd);
-        spill_.reset();
-        return;
-      }
-    }
+    if (!spill_) spill_ = make_spill_file(output_directory(), node_);
+    if (!spill_) return;  // stays in memory
     if (std::fwrite(rows_.data(), 1, rows_.size(), spill_->f) != rows_.size())
       throw ConfigError(std::string("cannot write a temporary file in the output folder: ") + std::strerror(errno),
                         path_where_, node_);

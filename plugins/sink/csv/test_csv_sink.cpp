@@ -1,7 +1,8 @@
-// Purpose: tests of sink.csv: header and rows, values against the inputs, empty cells, run order, measurement rows, paths.
+// Purpose: tests of sink.csv: header and rows, values against the inputs, empty cells, run order, measurement rows, paths, per-run rows sent between processes.
 #include <trackflow/geometry.hpp>
 #include <trackflow/host/guard.hpp>
 #include <trackflow/output_path.hpp>
+#include <trackflow/run_result_codec.hpp>
 
 #include <Eigen/Dense>
 #include <catch2/catch.hpp>
@@ -432,4 +433,118 @@ TEST_CASE("paths outside the output folder are refused") {
   allow_output_outside(true);
   CHECK_NOTHROW(test::make("sink.csv", "{ path: /tmp/x.csv }"));
   allow_output_outside(false);
+}
+
+namespace {
+
+// Temporary files of sink 'log' this process holds open in `dir` (they are unlinked at once, so
+// only /proc/self/fd still names them).
+int temp_files_in(const fs::path& dir) {
+  int n = 0;
+  const std::string prefix = (dir / ".log.run-").string();
+  for (const auto& e : fs::directory_iterator("/proc/self/fd")) {
+    std::error_code ec;
+    const fs::path target = fs::read_symlink(e.path(), ec);
+    if (!ec && target.string().rfind(prefix, 0) == 0) ++n;
+  }
+  return n;
+}
+
+// A run of `steps` steps (large enough to outgrow memory: 20 000 steps are ~6 MB of rows at ~160 bytes a row).
+void feed_long(Component& c, std::uint64_t run, int steps) {
+  for (int k = 0; k < steps; ++k) {
+    const double t = 0.1 * k;
+    const Truth tr = truth(t, Vec3(1000 + run, 2000 + 0.1 * k, 300), Vec3(-100, 50, 0));
+    Vec6 x;
+    x << tr.position, tr.velocity;
+    c.on_truth(tr, 2);
+    c.on_estimate(estimate(t, x + Vec6::Constant(1.0 / 3.0), covariance()), 0);
+    c.on_estimate(estimate(t, x - Vec6::Constant(2.0 / 7.0), covariance(), k % 2 == 0), 1);
+  }
+}
+
+}  // namespace
+
+// under mpirun a run's rows are sent as bytes (RunResultCodec) and merged on another instance:
+// the file is byte-identical to merging the runs where they ran, and a large run, spilled to a
+// temporary file where it ran, is spilled again where it is received instead of held in memory
+TEST_CASE("rows sent between processes give the same file") {
+  const fs::path root = scratch("codec");
+  const std::string work = (root / "work").string(), a = (root / "direct").string(), b = (root / "decoded").string();
+  auto worker = make_csv("{}");
+  auto direct = make_csv("{}");
+  auto decoded = make_csv("{}");
+  const auto& codec = dynamic_cast<const RunResultCodec&>(*worker);
+  Diagnostics diag;
+  std::size_t largest = 0;
+  for (std::uint64_t r = 0; r < 3; ++r) {
+    std::unique_ptr<RunResult> result;
+    {
+      host::OutputDirectoryScope scope(work);
+      worker->start_run({r, 1, &diag});
+      if (r == 1)
+        feed_long(*worker, r, 20000);
+      else
+        feed(*worker, r);
+      result = worker->end_run();
+      // The long run went to a temporary file where it ran.
+      CHECK(temp_files_in(root / "work") == (r == 1 ? 1 : 0));
+    }
+    std::string bytes;
+    ByteWriter w(bytes);
+    codec.save_run_result(*result, w);
+    largest = std::max(largest, bytes.size());
+    std::unique_ptr<RunResult> loaded;
+    {
+      host::OutputDirectoryScope scope(b);
+      ByteReader in(bytes.data(), bytes.size());
+      loaded = dynamic_cast<const RunResultCodec&>(*decoded).load_run_result(in);
+      CHECK(in.done());
+      // Received, the long run is kept in a temporary file again, not in memory.
+      CHECK(temp_files_in(root / "decoded") == (r == 1 ? 1 : 0));
+      // A truncated message is an error, not a short file.
+      ByteReader cut(bytes.data(), bytes.size() - 1);
+      CHECK_THROWS_AS(codec.load_run_result(cut), DataError);
+    }
+    {
+      host::OutputDirectoryScope scope(a);
+      direct->merge(*result);
+    }
+    {
+      host::OutputDirectoryScope scope(b);
+      decoded->merge(*loaded);
+    }
+  }
+  CHECK(largest > (std::size_t{4} << 20));
+  Summary sa, sb;
+  direct->finish(sa, {"log", a, 3});
+  decoded->finish(sb, {"log", b, 3});
+  REQUIRE(sa.metrics.size() == sb.metrics.size());
+  CHECK(sa.metrics[0].value == sb.metrics[0].value);  // rows
+  CHECK(sa.metrics[0].value == 2 * 2 + 2 * 20000 + 2 * 2);
+  const std::string file = slurp(fs::path(a) / "log.csv");
+  CHECK(file.size() > (std::size_t{4} << 20));
+  CHECK(slurp(fs::path(b) / "log.csv") == file);
+}
+
+// the first non-finite value's place and the count travel with the rows
+TEST_CASE("a NaN in a run sent between processes still fails the run") {
+  const fs::path dir = scratch("codec_nan");
+  auto worker = make_csv("{}", {kKf, kTruth});
+  auto aggregate = make_csv("{}", {kKf, kTruth});
+  Diagnostics diag;
+  worker->start_run({4, 1, &diag});
+  Vec6 x = Vec6::Zero();
+  x(2) = std::numeric_limits<double>::infinity();
+  worker->on_estimate(estimate(0.5, x, Mat6::Identity()), 0);
+  auto result = worker->end_run();
+  std::string bytes;
+  ByteWriter w(bytes);
+  dynamic_cast<const RunResultCodec&>(*worker).save_run_result(*result, w);
+  ByteReader in(bytes.data(), bytes.size());
+  auto loaded = dynamic_cast<const RunResultCodec&>(*aggregate).load_run_result(in);
+  aggregate->merge(*loaded);
+  Summary s;
+  CHECK_THROWS_WITH(aggregate->finish(s, {"log", dir.string(), 1}),
+                    Catch::Matchers::Contains("the first in run 4, t=0.5 s, column z"));
 }

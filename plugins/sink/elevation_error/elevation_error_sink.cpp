@@ -4,6 +4,7 @@
 #include "truth_match.hpp"
 
 #include <trackflow/plugin.hpp>
+#include <trackflow/run_result_codec.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -35,7 +36,7 @@ struct StepSums {
   std::uint64_t n = 0;
 };
 
-class ElevationErrorSink final : public Component {
+class ElevationErrorSink final : public Component, public RunResultCodec {
  public:
   explicit ElevationErrorSink(const Params& p)
       : below_(p.real_or("below", std::numeric_limits<double>::infinity())),
@@ -120,6 +121,21 @@ class ElevationErrorSink final : public Component {
       }
       r->samples.push_back(s);
     }
+    return r;
+  }
+
+  // The run's scored samples cross processes under mpirun, bit for bit (run_result_codec.hpp).
+  void save_run_result(const RunResult& result, ByteWriter& out) const override {
+    const auto& r = static_cast<const ElevationRunResult&>(result);
+    out.put_vector(r.samples);
+    out.put(r.non_finite);
+    out.put(r.unmatched);
+  }
+  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override {
+    auto r = std::make_unique<ElevationRunResult>();
+    in.get_vector(r->samples);
+    in.get(r->non_finite);
+    in.get(r->unmatched);
     return r;
   }
 
