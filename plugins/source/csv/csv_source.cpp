@@ -1,6 +1,10 @@
 // Purpose: source.csv — replays a recorded radar log (CSV with a header row) as Measurements, checking every row.
 #include "csv_text.hpp"
 
+#include <fcntl.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
 #include <trackflow/geometry.hpp>
 #include <trackflow/common_params.hpp>
 #include <trackflow/plugin.hpp>
@@ -12,7 +16,6 @@
 #include <cstdio>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 #include <limits>
 #include <map>
 #include <memory>
@@ -67,37 +70,56 @@ fs::path resolve_path(const Params& p) {
   return path;
 }
 
-// A log larger than this is refused rather than read into memory.
-constexpr std::uintmax_t kMaxFileBytes = std::uintmax_t{1} << 30;
+// An open log, closed with its last user.
+struct FileHandle {
+  int fd = -1;
+  FileHandle() = default;
+  FileHandle(const FileHandle&) = delete;
+  FileHandle& operator=(const FileHandle&) = delete;
+  ~FileHandle() {
+    if (fd >= 0) ::close(fd);
+  }
+};
 
-std::string read_file(const Params& p, const fs::path& path) {
+// What says that the file was not rewritten since it was checked.
+struct FileStamp {
+  std::uint64_t size = 0;
+  std::int64_t mtime_s = 0, mtime_ns = 0, inode = 0;
+  bool operator==(const FileStamp&) const = default;
+};
+
+FileStamp stamp_of(const struct stat& st) {
+  return {static_cast<std::uint64_t>(st.st_size), static_cast<std::int64_t>(st.st_mtim.tv_sec),
+          static_cast<std::int64_t>(st.st_mtim.tv_nsec), static_cast<std::int64_t>(st.st_ino)};
+}
+
+// Opens the log for reading (it is streamed, never read whole: any size will do).
+void open_file(const Params& p, const fs::path& path, FileHandle& file, FileStamp& stamp) {
   std::error_code ec;
   if (fs::is_directory(path, ec)) throw p.error("path", "'" + path.string() + "' is a directory, not a CSV file");
   // A FIFO would block and a device (/dev/zero) never end: only regular files are logs.
   const fs::file_status st = fs::status(path, ec);
   if (!ec && fs::exists(st) && !fs::is_regular_file(st))
     throw p.error("path", "'" + path.string() + "' is not a regular file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw p.error("path", "cannot open '" + path.string() + "': " + std::strerror(errno));
-  const std::uintmax_t size = fs::file_size(path, ec);
-  if (ec) throw p.error("path", "cannot read '" + path.string() + "': " + ec.message());
-  if (size > kMaxFileBytes)
-    throw p.error("path", "'" + path.string() + "' is larger than 1 GiB; split the log into several files");
-  std::string text(static_cast<std::size_t>(size), '\0');
-  if (!in.read(text.data(), static_cast<std::streamsize>(text.size())))
-    throw p.error("path", "cannot read '" + path.string() + "'");
-  return text;
+  // O_NONBLOCK: a file swapped for a FIFO after the check must not block the open either.
+  file.fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
+  if (file.fd < 0) throw p.error("path", "cannot open '" + path.string() + "': " + std::strerror(errno));
+  struct stat info;
+  if (::fstat(file.fd, &info) != 0) throw p.error("path", "cannot read '" + path.string() + "': " + std::strerror(errno));
+  if (!S_ISREG(info.st_mode)) throw p.error("path", "'" + path.string() + "' is not a regular file");
+  stamp = stamp_of(info);
 }
 
 // A cell of the file as a message may quote it: the offending token only, short, no control
 // characters (the file may not be a log at all).
+constexpr std::size_t kTokenChars = 40;
 std::string token(std::string_view s) {
   std::string t;
-  for (std::size_t i = 0; i < s.size() && i < 40; ++i) {
+  for (std::size_t i = 0; i < s.size() && i < kTokenChars; ++i) {
     const unsigned char c = static_cast<unsigned char>(s[i]);
     t += c < 0x20 || c == 0x7f ? '?' : static_cast<char>(c);
   }
-  return s.size() > 40 ? t + "..." : t;
+  return s.size() > kTokenChars ? t + "..." : t;
 }
 
 // Whether a header looks like column names (so that listing it quotes no content of a file
@@ -113,35 +135,38 @@ bool plausible_header(const std::vector<std::string>& names) {
   return true;
 }
 
-// One data row as replayed: what varies between rows (the rest is the source's prototype
-// measurement). 56 bytes instead of a whole Measurement, so 2e6 rows take ~110 MB.
-struct Row {
-  double time = 0.0;
-  double value[4] = {};
-  double snr_db = 0.0;
-  std::uint32_t sensor = 0;
-  MeasMode mode = MeasMode::Unknown;
-  bool valid = true;
-  bool has_snr = false;
-};
+// The columns a source may read, in the order their positions are kept.
+constexpr int kColumns = 9;
 
-// The parsed file, shared read-only by every instance (one per worker thread, plus the one
-// that aggregates) built from the same file and parameters: parsed once, held once.
-struct ParsedLog {
-  std::vector<Row> rows;
+// What checking the whole file found, shared read-only by every instance (one per worker
+// thread, plus the one that aggregates) built from the same file and parameters. No rows are
+// kept: each instance streams them from the file again in every run, through a buffer the size
+// of the longest line, with the same parser, so memory does not grow with the log.
+struct CheckedLog {
+  FileHandle file;
+  FileStamp stamp;
+  // Where the data rows are: bytes [data_begin, data_end), the first on line first_data_line.
+  std::uint64_t data_begin = 0, data_end = 0;
+  bool last_terminated = true;
+  int first_data_line = 0;
+  int header_line = 0;
+  std::size_t field_count = 0;
+  int column_index[kColumns] = {};
+  std::size_t buffer = 0;            // a stream buffer that holds every data line
+  std::size_t good_rows = 0;         // rows replayed in a run
   std::vector<std::string> skipped;  // the first kMaxSkipMessages messages
   std::size_t skipped_count = 0;
   std::size_t rows_read = 0;
 };
 constexpr std::size_t kMaxSkipMessages = 1000;
 
-// Files parsed by this process, by path, file identity and parameters. Weak: a log is freed
+// Files checked by this process, by path, file identity and parameters. Weak: a log is freed
 // with its last instance, except the latest one, kept so that `validate`'s build and the run's
-// instances share one parse.
+// instances share one check.
 struct LogCache {
   std::mutex mutex;
-  std::map<std::string, std::weak_ptr<const ParsedLog>> logs;
-  std::shared_ptr<const ParsedLog> latest;
+  std::map<std::string, std::weak_ptr<const CheckedLog>> logs;
+  std::shared_ptr<const CheckedLog> latest;
 };
 LogCache& log_cache() {
   static LogCache* cache = new LogCache();  // never destroyed: instances may outlive statics
@@ -180,29 +205,43 @@ class CsvSource final : public Generator {
  public:
   explicit CsvSource(const Params& p) : node_(p.node()), skip_bad_rows_(p.choice<OnBadRow>("on_bad_row") == OnBadRow::Skip) {
     configure(p);
+    current_ = prototype_;  // checking parses into it
     const fs::path path = resolve_path(p);
     file_ = path.string();
     const std::string key = cache_key(p, path);
     LogCache& cache = log_cache();
-    // Held while parsing: instances built at the same time wait for the one parse and share it.
+    // Held while checking: instances built at the same time wait for the one check and share it.
     std::lock_guard<std::mutex> lock(cache.mutex);
     if (auto it = cache.logs.find(key); it != cache.logs.end()) log_ = it->second.lock();
     if (!log_) {
-      auto parsed = std::make_shared<ParsedLog>();
-      building_ = parsed.get();
-      parse(read_file(p, path));
-      building_ = nullptr;
-      log_ = parsed;
+      auto checked = std::make_shared<CheckedLog>();
+      open_file(p, path, checked->file, checked->stamp);
+      check(*checked);
+      log_ = checked;
       for (auto it = cache.logs.begin(); it != cache.logs.end();)
         it = it->second.expired() ? cache.logs.erase(it) : std::next(it);
       cache.logs[key] = log_;
     }
     cache.latest = log_;
-    current_ = prototype_;
+    Column* columns[kColumns] = {&time_, &value_[0], &value_[1], &value_[2], &range_rate_, &snr_, &mode_, &valid_, &sensor_};
+    for (int i = 0; i < kColumns; ++i) columns[i]->index = log_->column_index[i];
+    field_count_ = log_->field_count;
+    header_number_ = log_->header_line;
+    // Sized for the longest data line: replaying never allocates.
+    stream_ = csv::LineStream(log_->buffer);
+    fields_.reserve(field_count_ + 1);
   }
 
   void start_run(const RunContext& ctx) override {
-    cursor_ = 0;
+    // A log rewritten since it was checked would replay rows nobody checked.
+    struct stat info;
+    if (::fstat(log_->file.fd, &info) != 0 || !(stamp_of(info) == log_->stamp))
+      fail(file_ + ": the file changed after it was checked when the pipeline was built; do not rewrite a log while "
+                   "a pipeline reads it");
+    stream_.open(log_->file.fd, log_->data_begin, log_->data_end, log_->last_terminated, log_->first_data_line);
+    has_previous_ = false;
+    replayed_ = left_out_ = 0;
+    has_current_ = false;
     // Every instance replays the same rows; only run 0 reports, so each bad row is counted once.
     if (ctx.run == 0 && ctx.diagnostics) {
       for (const auto& message : log_->skipped) ctx.diagnostics->skip(node_, message);
@@ -210,25 +249,17 @@ class CsvSource final : public Generator {
         ctx.diagnostics->skip(node_, "... and " + std::to_string(log_->skipped_count - log_->skipped.size()) +
                                          " more bad rows left out (all counted in skipped_rows)");
     }
+    advance();
   }
 
   FrameMask produced_frames() const override { return mask(frame_); }
 
-  double next_time() const override {
-    return cursor_ < log_->rows.size() ? log_->rows[cursor_].time : std::numeric_limits<double>::infinity();
-  }
+  double next_time() const override { return has_current_ ? current_.time : std::numeric_limits<double>::infinity(); }
 
   void emit_next() override {
-    if (cursor_ >= log_->rows.size()) return;
-    const Row& r = log_->rows[cursor_++];
-    current_.time = r.time;
-    for (int k = 0; k < current_.value.size(); ++k) current_.value(k) = r.value[k];
-    current_.snr_db = r.snr_db;
-    current_.has_snr = r.has_snr;
-    current_.mode = r.mode;
-    current_.valid = r.valid;
-    current_.sensor = r.sensor;
+    if (!has_current_) return;
     out.emit(current_);
+    advance();
   }
 
   void finish(Summary& s, const FinishContext&) override {
@@ -340,146 +371,174 @@ class CsvSource final : public Generator {
     field_count_ = names.size();
   }
 
-  void parse(const std::string& text) {
-    // Lines are taken one at a time (no table of 2e6 lines); blank lines after the last
-    // non-blank one are fine, so find where the content ends first.
-    std::size_t content_end = text.size();
-    for (;;) {
-      const std::size_t nl = content_end == 0 ? std::string::npos : text.rfind('\n', content_end - 1);
-      const std::size_t start = nl == std::string::npos ? 0 : nl + 1;
-      if (!csv::is_blank(std::string_view(text).substr(start, content_end - start))) break;
-      if (start == 0) {
-        content_end = 0;
-        break;
-      }
-      content_end = nl;  // drop this blank line (and its newline)
-    }
-    csv::LineReader reader(std::string_view(text).substr(0, content_end), text.size() > content_end);
-    csv::Line header_line;
-    // Leading blank lines are skipped.
-    bool have_header = false;
-    while (reader.next(header_line))
-      if (!csv::is_blank(header_line.text)) {
-        have_header = true;
-        break;
-      }
-    if (!have_header) fail(file_ + ": the file is empty; expected a header row, then one row per measurement");
+  // Reads the whole file once, line by line, and checks every row: a bad row stops the pipeline
+  // here (or is counted, with on_bad_row: skip), so `trackflow validate` finds data problems too.
+  void check(CheckedLog& log) {
+    try {
+      // Blank lines after the last non-blank one are fine: find where the content ends first.
+      const std::uint64_t end = csv::content_end(log.file.fd, log.stamp.size);
+      csv::LineStream& reader = stream_;
+      reader.open(log.file.fd, 0, end, log.stamp.size > end, 1);
+      csv::Line header_line;
+      // Leading blank lines are skipped.
+      bool have_header = false;
+      while (reader.next(header_line))
+        if (!csv::is_blank(header_line.text)) {
+          have_header = true;
+          break;
+        }
+      if (!have_header) fail(file_ + ": the file is empty; expected a header row, then one row per measurement");
 
-    std::vector<std::string_view> fields;
-    if (std::string why = csv::split_fields(header_line.text, fields); !why.empty())
-      fail(at(header_line.number) + "header: " + why);
-    // A UTF-8 byte-order mark (spreadsheet exports) is not part of the first column's name.
-    if (!fields.empty() && fields[0].starts_with("\xEF\xBB\xBF")) {
-      fields[0].remove_prefix(3);
-      if (!fields[0].empty() && fields[0].front() == '"' && fields[0].size() >= 2 && fields[0].back() == '"')
-        fields[0] = fields[0].substr(1, fields[0].size() - 2);
-    }
-    locate_columns(header_line, fields);
-    header_number_ = header_line.number;
-    if (reader.done()) fail(at(header_line.number) + "the file has a header but no data rows");
-
-    ParsedLog& log = *building_;
-    log.rows.reserve(static_cast<std::size_t>(std::count(text.begin(), text.begin() + static_cast<std::ptrdiff_t>(content_end), '\n')) + 1);
-    csv::Line line;
-    Measurement m = prototype_;
-    while (reader.next(line)) {
-      ++log.rows_read;
-      const bool last = reader.done();
-      std::string why = read_row(line, last, fields, m);
-      if (why.empty()) {
-        Row& r = log.rows.emplace_back();
-        r.time = m.time;
-        for (int k = 0; k < m.value.size() && k < 4; ++k) r.value[k] = m.value(k);
-        r.snr_db = m.snr_db;
-        r.has_snr = m.has_snr;
-        r.mode = m.mode;
-        r.valid = m.valid;
-        r.sensor = m.sensor;
-        continue;
+      std::vector<std::string_view>& fields = fields_;
+      if (std::string why = csv::split_fields(header_line.text, fields); !why.empty())
+        fail(at(header_line.number) + "header: " + why);
+      // A UTF-8 byte-order mark (spreadsheet exports) is not part of the first column's name.
+      if (!fields.empty() && fields[0].starts_with("\xEF\xBB\xBF")) {
+        fields[0].remove_prefix(3);
+        if (!fields[0].empty() && fields[0].front() == '"' && fields[0].size() >= 2 && fields[0].back() == '"')
+          fields[0] = fields[0].substr(1, fields[0].size() - 2);
       }
-      why = at(line.number) + why;
-      if (!skip_bad_rows_) fail(why);
-      if (log.skipped.size() < kMaxSkipMessages) log.skipped.push_back(std::move(why));
-      ++log.skipped_count;
+      locate_columns(header_line, fields);
+      header_number_ = header_line.number;
+      if (reader.done()) fail(at(header_line.number) + "the file has a header but no data rows");
+
+      log.header_line = header_line.number;
+      log.field_count = field_count_;
+      const Column* columns[kColumns] = {&time_, &value_[0], &value_[1], &value_[2], &range_rate_, &snr_, &mode_, &valid_, &sensor_};
+      for (int i = 0; i < kColumns; ++i) log.column_index[i] = columns[i]->index;
+      log.data_begin = reader.offset();
+      log.data_end = end;
+      log.last_terminated = log.stamp.size > end;
+      log.first_data_line = header_line.number + 1;
+
+      std::size_t longest = 0;
+      csv::Line line;
+      std::string why;
+      while (reader.next(line)) {
+        ++log.rows_read;
+        longest = std::max(longest, line.text.size());
+        if (read_row(line, reader.done(), fields, current_, &why)) {
+          ++log.good_rows;
+          continue;
+        }
+        why = at(line.number) + why;
+        if (!skip_bad_rows_) fail(why);
+        if (log.skipped.size() < kMaxSkipMessages) log.skipped.push_back(std::move(why));
+        ++log.skipped_count;
+      }
+      // With room for a stripped "\r\n": a replay then never grows its buffer.
+      log.buffer = std::max(csv::LineStream::kDefaultCapacity, longest + 2);
+    } catch (const csv::ReadError& e) {
+      fail(e.line > 0 ? at(e.line) + e.what() : file_ + ": " + e.what());
     }
   }
 
-  // Fills `m` from one data line; returns what is wrong with the line, or "" if nothing.
-  std::string read_row(const csv::Line& line, bool last, std::vector<std::string_view>& fields, Measurement& m) {
+  // Moves current_ to the next good row of this run (has_current_ false at the end). The rows were
+  // checked when the pipeline was built, so only a file rewritten since makes one fail here.
+  void advance() {
+    has_current_ = false;
+    try {
+      csv::Line line;
+      while (stream_.next(line)) {
+        if (read_row(line, stream_.done(), fields_, current_, nullptr)) {
+          ++replayed_;
+          has_current_ = true;
+          return;
+        }
+        if (!skip_bad_rows_) {
+          std::string why;
+          read_row(line, stream_.done(), fields_, current_, &why);
+          fail(at(line.number) + why + " (the file changed after it was checked when the pipeline was built)");
+        }
+        ++left_out_;
+      }
+    } catch (const csv::ReadError& e) {
+      fail(file_ + ": the file changed after it was checked when the pipeline was built (" + e.what() + ")");
+    }
+    if (replayed_ != log_->good_rows || left_out_ != log_->skipped_count)
+      fail(file_ + ": the file changed after it was checked when the pipeline was built (" + std::to_string(replayed_) +
+           " good rows now, " + std::to_string(log_->good_rows) + " then)");
+  }
+
+  // Fills `m` from one data line; true if it is a good row. Otherwise `why`, if given, says what
+  // is wrong with the line; without it nothing is built (a skipped row replayed in a run).
+  bool read_row(const csv::Line& line, bool last, std::vector<std::string_view>& fields, Measurement& m,
+                std::string* why) {
     m.snr_db = prototype_.snr_db;
     m.has_snr = prototype_.has_snr;
     m.mode = prototype_.mode;
     m.valid = prototype_.valid;
     m.sensor = prototype_.sensor;
-    const std::string truncated = last && !line.terminated ? "the last line looks truncated (no newline at the end of the file): " : "";
+    auto reject = [why](auto&& message) {
+      if (why) *why = message();
+      return false;
+    };
+    const std::string_view truncated =
+        last && !line.terminated ? "the last line looks truncated (no newline at the end of the file): " : "";
     if (csv::is_blank(line.text))
-      return "empty line inside the data (expected " + std::to_string(field_count_) + " fields as in the header)";
-    if (std::string why = csv::split_fields(line.text, fields); !why.empty()) return truncated + why;
-    if (fields.size() != field_count_) {
-      const std::string counts = "expected " + std::to_string(field_count_) + " fields as in the header (line " +
-                                 std::to_string(header_number_) + "), got " + std::to_string(fields.size());
-      if (last && fields.size() < field_count_)
-        return "truncated last line: " + counts + (line.terminated ? "" : " (no newline at the end of the file)");
-      return "wrong number of fields: " + counts;
-    }
+      return reject([&] {
+        return "empty line inside the data (expected " + std::to_string(field_count_) + " fields as in the header)";
+      });
+    if (std::string e = csv::split_fields(line.text, fields); !e.empty())
+      return reject([&] { return std::string(truncated) + e; });
+    if (fields.size() != field_count_)
+      return reject([&] {
+        const std::string counts = "expected " + std::to_string(field_count_) + " fields as in the header (line " +
+                                   std::to_string(header_number_) + "), got " + std::to_string(fields.size());
+        if (last && fields.size() < field_count_)
+          return "truncated last line: " + counts + (line.terminated ? "" : " (no newline at the end of the file)");
+        return "wrong number of fields: " + counts;
+      });
 
-    std::string problem;
-    auto complain = [&](const std::string& what, const Column& c) {
-      problem = what + " (column " + c.name + ", value '" + token(fields[c.index]) + "')";
+    auto complain = [&](std::string_view prefix, std::string_view what, const Column& c) {
+      return reject([&] {
+        return std::string(prefix) + std::string(what) + " (column " + c.name + ", value '" + token(fields[c.index]) + "')";
+      });
     };
     // An empty or half-written cell on an unterminated last line is most likely a cut-off write.
     auto real = [&](const Column& c, double& v) {
       switch (csv::parse_real(fields[c.index], v)) {
         case csv::CellStatus::Ok: return true;
-        case csv::CellStatus::Empty: complain(truncated + "empty value where a number is expected", c); return false;
-        case csv::CellStatus::NotFinite: complain("NaN or infinite value", c); return false;
-        case csv::CellStatus::Malformed: complain(truncated + "not a number", c); return false;
+        case csv::CellStatus::Empty: return complain(truncated, "empty value where a number is expected", c);
+        case csv::CellStatus::NotFinite: return complain("", "NaN or infinite value", c);
+        case csv::CellStatus::Malformed: return complain(truncated, "not a number", c);
       }
       return false;
     };
 
     double t = 0.0;
-    if (!real(time_, t)) return problem;
+    if (!real(time_, t)) return false;
     t *= time_scale_;
     if (has_previous_ && t < previous_time_) {
-      complain("time goes backwards: earlier than " + token(previous_time_text_) + " on line " +
-                   std::to_string(previous_line_),
-               time_);
-      return problem;
+      if (!why) return false;
+      return complain("",
+                      "time goes backwards: earlier than " +
+                          token(std::string_view(previous_time_text_, previous_time_length_)) + " on line " +
+                          std::to_string(previous_line_),
+                      time_);
     }
     m.time = t;
     for (int k = 0; k < 3; ++k) {
       double v = 0.0;
-      if (!real(value_[k], v)) return problem;
+      if (!real(value_[k], v)) return false;
       m.value(k) = v * scale_[k];
       // Finite in the file's unit is not enough: 1e306 km is infinite in metres.
-      if (!std::isfinite(m.value(k))) {
-        complain("value overflows when converted to SI", value_[k]);
-        return problem;
-      }
+      if (!std::isfinite(m.value(k))) return complain("", "value overflows when converted to SI", value_[k]);
     }
     if (m.frame == Frame::Spherical) {
-      if (m.value(0) < 0.0) {
-        complain("negative range", value_[0]);
-        return problem;
-      }
-      if (std::fabs(m.value(2)) > std::numbers::pi / 2 * (1 + 1e-12)) {
-        complain("elevation beyond +-90 deg", value_[2]);
-        return problem;
-      }
+      if (m.value(0) < 0.0) return complain("", "negative range", value_[0]);
+      if (std::fabs(m.value(2)) > std::numbers::pi / 2 * (1 + 1e-12))
+        return complain("", "elevation beyond +-90 deg", value_[2]);
       m.value(1) = wrap_angle(m.value(1));
     }
     if (range_rate_.read()) {
       double v = 0.0;
-      if (!real(range_rate_, v)) return problem;
+      if (!real(range_rate_, v)) return false;
       m.value(3) = v * rdot_scale_;
-      if (!std::isfinite(m.value(3))) {
-        complain("value overflows when converted to SI", range_rate_);
-        return problem;
-      }
+      if (!std::isfinite(m.value(3))) return complain("", "value overflows when converted to SI", range_rate_);
     }
     if (snr_.read()) {
-      if (!real(snr_, m.snr_db)) return problem;
+      if (!real(snr_, m.snr_db)) return false;
       m.has_snr = true;
     }
     if (mode_.read()) {
@@ -488,19 +547,19 @@ class CsvSource final : public Generator {
                : csv::iequals(mode, "skin") ? MeasMode::Skin
                                              : MeasMode::Unknown;
     }
-    if (valid_.read() && csv::parse_flag(fields[valid_.index], m.valid) != csv::CellStatus::Ok) {
-      complain("not a validity flag (expected 1, 0, true or false)", valid_);
-      return problem;
-    }
-    if (sensor_.read() && csv::parse_id(fields[sensor_.index], m.sensor) != csv::CellStatus::Ok) {
-      complain("not a sensor id (expected a non-negative integer)", sensor_);
-      return problem;
-    }
+    if (valid_.read() && csv::parse_flag(fields[valid_.index], m.valid) != csv::CellStatus::Ok)
+      return complain("", "not a validity flag (expected 1, 0, true or false)", valid_);
+    if (sensor_.read() && csv::parse_id(fields[sensor_.index], m.sensor) != csv::CellStatus::Ok)
+      return complain("", "not a sensor id (expected a non-negative integer)", sensor_);
     has_previous_ = true;
     previous_time_ = t;
-    previous_time_text_ = fields[time_.index];
+    // The line's text is gone once the stream reads on: keep what token() may quote of it (one
+    // character more than it shows, so that it still knows whether to cut).
+    const std::string_view time_text = fields[time_.index];
+    previous_time_length_ = std::min(time_text.size(), sizeof previous_time_text_);
+    std::memcpy(previous_time_text_, time_text.data(), previous_time_length_);
     previous_line_ = line.number;
-    return {};
+    return true;
   }
 
   // Configuration.
@@ -513,17 +572,20 @@ class CsvSource final : public Generator {
   std::size_t field_count_ = 0;
   int header_number_ = 1;
 
-  // Parsing state (constructor only; the text views point into the file being read).
+  // Reading state, reset at each run: the time order of the good rows.
   bool has_previous_ = false;
   double previous_time_ = 0.0;
-  std::string_view previous_time_text_;
+  char previous_time_text_[kTokenChars + 1] = {};
+  std::size_t previous_time_length_ = 0;
   int previous_line_ = 0;
 
-  // The replayed data.
-  std::shared_ptr<const ParsedLog> log_;
-  ParsedLog* building_ = nullptr;  // while this instance parses
-  Measurement current_;            // the prototype with the fields of the row being emitted
-  std::size_t cursor_ = 0;
+  // The replayed data: checked once, shared; streamed again by each instance in every run.
+  std::shared_ptr<const CheckedLog> log_;
+  csv::LineStream stream_;
+  std::vector<std::string_view> fields_;
+  Measurement current_;  // the row to emit next (the prototype with its fields)
+  bool has_current_ = false;
+  std::size_t replayed_ = 0, left_out_ = 0;  // good and bad rows of this run so far
   Frame frame_ = Frame::Spherical;
 };
 
@@ -579,7 +641,9 @@ void register_components(Registrar& r) {
   d.kind = ComponentKind::Source;
   d.summary = "Recorded radar log (CSV with a header row) replayed as measurements, in file order";
   d.doc = "The whole file is read and checked when the pipeline is built, so `trackflow validate` also finds data "
-          "problems. Each bad row (not a number, NaN/inf, wrong field count, negative range, time going backwards, "
+          "problems; each run then streams the rows from the file again through a buffer of the longest line, so "
+          "memory does not grow with the length of the log (a file rewritten while the pipeline runs is an error). "
+          "Each bad row (not a number, NaN/inf, wrong field count, negative range, time going backwards, "
           "truncated last line) is reported as FILE:LINE; with on_bad_row: skip it is left out and counted. "
           "Accepts CRLF line endings and double-quoted fields without embedded commas. Metrics: rows (data rows "
           "read), skipped_rows.";

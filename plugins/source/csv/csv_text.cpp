@@ -1,9 +1,13 @@
-// Purpose: CSV line and field splitting and strict cell parsing (see csv_text.hpp).
+// Purpose: streaming a CSV file line by line, field splitting and strict cell parsing (see csv_text.hpp).
 #include "csv_text.hpp"
 
+#include <unistd.h>
+
 #include <algorithm>
+#include <cerrno>
 #include <charconv>
 #include <cmath>
+#include <cstring>
 #include <limits>
 
 namespace trackflow::csv {
@@ -36,38 +40,90 @@ std::size_t edit_distance(std::string_view a, std::string_view b) {
 
 }  // namespace
 
-std::vector<Line> split_lines(std::string_view text) {
-  std::vector<Line> lines;
-  lines.reserve(static_cast<std::size_t>(std::count(text.begin(), text.end(), '\n')) + 1);
-  int number = 1;
-  while (!text.empty()) {
-    const auto nl = text.find('\n');
-    Line line;
-    line.number = number++;
-    line.terminated = nl != std::string_view::npos;
-    line.text = text.substr(0, line.terminated ? nl : text.size());
-    if (!line.text.empty() && line.text.back() == '\r') line.text.remove_suffix(1);
-    lines.push_back(line);
-    text.remove_prefix(line.terminated ? nl + 1 : text.size());
-  }
-  return lines;
+LineStream::LineStream(std::size_t capacity)
+    : buf_(new char[std::clamp(capacity, std::size_t{1}, kMaxLine)]), capacity_(std::clamp(capacity, std::size_t{1}, kMaxLine)) {}
+
+void LineStream::open(int fd, std::uint64_t begin, std::uint64_t end, bool last_terminated, int first_number) {
+  fd_ = fd;
+  file_pos_ = begin;
+  end_ = std::max(begin, end);
+  last_terminated_ = last_terminated;
+  number_ = first_number - 1;
+  pos_ = len_ = 0;
 }
 
-bool LineReader::next(Line& line) {
-  if (pos_ >= text_.size()) return false;
-  const auto nl = text_.find('\n', pos_);
-  line.number = ++number_;
-  if (nl == std::string_view::npos) {
-    line.text = text_.substr(pos_);
-    line.terminated = last_terminated_;
-    pos_ = text_.size();
-  } else {
-    line.text = text_.substr(pos_, nl - pos_);
-    line.terminated = true;
-    pos_ = nl + 1;
+bool LineStream::next(Line& line) {
+  for (;;) {
+    if (pos_ < len_)
+      if (const void* nl = std::memchr(buf_.get() + pos_, '\n', len_ - pos_)) {
+        const std::size_t at = static_cast<std::size_t>(static_cast<const char*>(nl) - buf_.get());
+        line.text = std::string_view(buf_.get() + pos_, at - pos_);
+        line.terminated = true;
+        pos_ = at + 1;
+        break;
+      }
+    if (file_pos_ >= end_) {
+      if (pos_ >= len_) return false;
+      // The range's last line: its break (if any) lies beyond `end`.
+      line.text = std::string_view(buf_.get() + pos_, len_ - pos_);
+      line.terminated = last_terminated_;
+      pos_ = len_;
+      break;
+    }
+    refill();
   }
+  line.number = ++number_;
   if (!line.text.empty() && line.text.back() == '\r') line.text.remove_suffix(1);
   return true;
+}
+
+void LineStream::refill() {
+  // The start of a line that continues beyond the buffer moves to its front.
+  const std::size_t keep = len_ - pos_;
+  if (pos_ > 0 && keep > 0) std::memmove(buf_.get(), buf_.get() + pos_, keep);
+  pos_ = 0;
+  len_ = keep;
+  if (len_ == capacity_) {
+    if (capacity_ >= kMaxLine)
+      throw ReadError("line longer than 1 GiB (no log has such rows; is this a CSV log?)", number_ + 1);
+    const std::size_t grown = std::min(2 * capacity_, kMaxLine);
+    std::unique_ptr<char[]> bigger(new char[grown]);
+    std::memcpy(bigger.get(), buf_.get(), len_);
+    buf_ = std::move(bigger);
+    capacity_ = grown;
+  }
+  const std::size_t want = static_cast<std::size_t>(std::min<std::uint64_t>(capacity_ - len_, end_ - file_pos_));
+  ssize_t n;
+  do n = ::pread(fd_, buf_.get() + len_, want, static_cast<off_t>(file_pos_));
+  while (n < 0 && errno == EINTR);
+  if (n < 0) throw ReadError(std::string("cannot read: ") + std::strerror(errno), 0);
+  if (n == 0) throw ReadError("the file became shorter while it was read", 0);
+  len_ += static_cast<std::size_t>(n);
+  file_pos_ += static_cast<std::uint64_t>(n);
+}
+
+std::uint64_t content_end(int fd, std::uint64_t size) {
+  char chunk[64 << 10];
+  std::uint64_t next_break = size;  // the first line break after the bytes scanned so far
+  for (std::uint64_t hi = size; hi > 0;) {
+    const std::uint64_t lo = hi > sizeof chunk ? hi - sizeof chunk : 0;
+    std::size_t got = 0;
+    while (got < hi - lo) {
+      const ssize_t n = ::pread(fd, chunk + got, static_cast<std::size_t>(hi - lo) - got, static_cast<off_t>(lo + got));
+      if (n < 0 && errno == EINTR) continue;
+      if (n < 0) throw ReadError(std::string("cannot read: ") + std::strerror(errno), 0);
+      if (n == 0) throw ReadError("the file became shorter while it was read", 0);
+      got += static_cast<std::size_t>(n);
+    }
+    for (std::size_t i = static_cast<std::size_t>(hi - lo); i-- > 0;) {
+      if (chunk[i] == '\n')
+        next_break = lo + i;
+      else if (!blank_char(chunk[i]))
+        return next_break;
+    }
+    hi = lo;
+  }
+  return 0;
 }
 
 bool is_blank(std::string_view s) { return trim(s).empty(); }

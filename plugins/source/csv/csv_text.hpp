@@ -1,7 +1,9 @@
-// Purpose: splitting CSV text into numbered lines and fields, and strict parsing of numeric, boolean and integer cells.
+// Purpose: reading a CSV file line by line through a bounded buffer, splitting lines into fields, and strict parsing of numeric, boolean and integer cells.
 #pragma once
 
 #include <cstdint>
+#include <memory>
+#include <stdexcept>
 #include <string>
 #include <string_view>
 #include <vector>
@@ -14,24 +16,50 @@ struct Line {
   bool terminated = true;   // false: the file ends inside this line (no final newline)
 };
 
-// Every line of `text`, in order. A file ending with "\n" has no extra empty last line.
-std::vector<Line> split_lines(std::string_view text);
-
-// The lines of `text` one at a time, as split_lines numbers them, without a table of them all.
-// `text` must not end with a newline (cut it after the last line); `last_terminated` says
-// whether that last line had one in the file.
-class LineReader {
+// The lines of the bytes [begin, end) of an open file, numbered from `first_number` as an editor
+// shows them, read with pread through one buffer: memory is the longest line, not the file. As
+// for a text cut after its last line, the range must not end with a newline; `last_terminated`
+// says whether that last line had one in the file. Views returned by next() stay valid only
+// until the following call. Several streams may read one descriptor at once (pread has no
+// shared offset).
+class LineStream {
  public:
-  LineReader(std::string_view text, bool last_terminated) : text_(text), last_terminated_(last_terminated) {}
+  static constexpr std::size_t kDefaultCapacity = std::size_t{256} << 10;
+  // A line longer than this is refused: no log has such rows, and the buffer must stay bounded.
+  static constexpr std::size_t kMaxLine = std::size_t{1} << 30;
+
+  // The buffer grows only for a line longer than `capacity`: give the longest line's length plus
+  // its line break and it never allocates after construction.
+  explicit LineStream(std::size_t capacity = kDefaultCapacity);
+  void open(int fd, std::uint64_t begin, std::uint64_t end, bool last_terminated, int first_number);
+  // The next line, or false at the end of the range; throws ReadError.
   bool next(Line& line);
-  bool done() const { return pos_ >= text_.size(); }
+  bool done() const { return pos_ >= len_ && file_pos_ >= end_; }
+  // File offset of the next line.
+  std::uint64_t offset() const { return file_pos_ - (len_ - pos_); }
 
  private:
-  std::string_view text_;
-  bool last_terminated_;
-  std::size_t pos_ = 0;
+  void refill();
+
+  std::unique_ptr<char[]> buf_;
+  std::size_t capacity_ = 0, pos_ = 0, len_ = 0;
+  int fd_ = -1;
+  std::uint64_t file_pos_ = 0, end_ = 0;
+  bool last_terminated_ = true;
   int number_ = 0;
 };
+
+// What LineStream throws: an I/O error, a file that shrank while it was read, or a line too long
+// to buffer (`line` > 0: its number).
+struct ReadError : std::runtime_error {
+  ReadError(const std::string& what, int line) : std::runtime_error(what), line(line) {}
+  int line;
+};
+
+// Where the content of a file of `size` bytes ends: the offset of the line break after its last
+// non-blank line (blank lines after it are no data), `size` if that line has none, 0 if the file
+// is blank. Reads the file backward from its end in small chunks; throws ReadError.
+std::uint64_t content_end(int fd, std::uint64_t size);
 
 bool is_blank(std::string_view s);
 

@@ -442,3 +442,74 @@ TEST_CASE("many skipped rows keep a bounded message list") {
   CHECK(summary.find("skipped_rows")->value == 3000);
   CHECK(summary.find("rows")->value == 3001);
 }
+
+// a log many stream buffers long, with CRLF, bad rows and one line longer than the default buffer,
+// replays the same rows in every run, from each instance
+TEST_CASE("a long log is streamed again in every run") {
+  TempDir dir;
+  std::string text = "time,range,azimuth,elevation,note\r\n";
+  std::vector<double> ranges;
+  for (int i = 0; i < 30000; ++i) {
+    const double range = 1000 + i;
+    // Every 997th row is bad; row 15000 carries a note of 600 kB (beyond the 256 KiB buffer).
+    if (i % 997 == 5) {
+      text += std::to_string(i) + ",abc,0,0,x\r\n";
+      continue;
+    }
+    text += std::to_string(i) + "," + std::to_string(range) + ",0.5,0.25," + (i == 15000 ? std::string(600000, 'n') : "y") + "\r\n";
+    ranges.push_back(range);
+  }
+  const std::string file = dir.write("long.csv", text);
+  auto first = test::make("source.csv", yaml_params(file, "on_bad_row: skip"), "radar");
+  auto second = test::make("source.csv", yaml_params(file, "on_bad_row: skip"), "radar");
+  for (auto* src : {first.get(), second.get()}) {
+    test::Collector out;
+    out.attach_to(*src);
+    Diagnostics run0, run1;
+    test::drain(*src, 1, 0, &run0);
+    test::drain(*src, 1, 1, &run1);
+    REQUIRE(out.measurements.size() == 2 * ranges.size());
+    for (std::size_t k = 0; k < out.measurements.size(); ++k) {
+      const Measurement& m = out.measurements[k];
+      REQUIRE(m.value(0) == ranges[k % ranges.size()]);
+      REQUIRE(m.value(2) == Approx(0.25 * kDeg));
+    }
+    CHECK(run0.skips.size() == 31);
+    CHECK_THAT(run0.skips[0].message, Catch::Matchers::Contains("long.csv:7: not a number (column range, value 'abc')"));
+    CHECK(run1.skips.empty());
+    Summary summary;
+    src->finish(summary, {"radar", "", 2});
+    CHECK(summary.find("rows")->value == 30000);
+    CHECK(summary.find("skipped_rows")->value == 31);
+  }
+}
+
+// the rows are read again in each run: a log rewritten in place since the check is refused, while
+// one replaced by a new file (renamed over it) replays what was checked
+TEST_CASE("a log rewritten after the check is an error in the run") {
+  TempDir dir;
+  const std::string header = "time,range,azimuth,elevation\n";
+  const std::string file = dir.write("log.csv", header + "0,100,0,0\n1,200,0,0\n");
+  auto src = test::make("source.csv", yaml_params(file));
+  test::Collector out;
+  out.attach_to(*src);
+  test::drain(*src, 1, 0);
+  CHECK(out.measurements.size() == 2);
+
+  SECTION("in place") {
+    { std::ofstream(file, std::ios::binary | std::ios::app) << "2,abc,0,0\n"; }
+    try {
+      test::drain(*src, 1, 1);
+      FAIL("a rewritten log must be refused");
+    } catch (const DataError& e) {
+      CHECK_THAT(e.what(), Catch::Matchers::Contains("log.csv: the file changed after it was checked"));
+    }
+  }
+  SECTION("replaced") {
+    const std::string other = dir.write("other.csv", header + "0,7,0,0\n");
+    fs::rename(other, file);
+    test::drain(*src, 1, 1);
+    REQUIRE(out.measurements.size() == 4);
+    CHECK(out.measurements[3].value(0) == 200);
+  }
+}
