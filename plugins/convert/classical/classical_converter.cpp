@@ -36,9 +36,20 @@ class ClassicalConverter final : public Component {
     m_.has_snr = in.has_snr;
     m_.snr_db = in.snr_db;
     m_.sensor_position = in.sensor_position;
+    // spherical_to_enu and spherical_to_enu_jacobian (geometry.hpp) written out on one set of
+    // sines and cosines, from glibc's sincos (which the compiler made of their sin and cos calls
+    // before, and may not do here): the same expressions, the same bits.
+    double saz, caz, se, ce;
+    ::sincos(az, &saz, &caz);
+    ::sincos(el, &se, &ce);
+    const AzimuthBasis b = in.azimuth == AzimuthConvention::NorthClockwise ? AzimuthBasis{saz, caz, caz, -saz}
+                                                                           : AzimuthBasis{caz, saz, -saz, caz};
     m_.value.resize(n);
-    m_.value.head<3>() = spherical_to_enu(r, az, el, in.azimuth) + in.sensor_position;
-    const Mat3 J = spherical_to_enu_jacobian(r, az, el, in.azimuth);
+    m_.value.head<3>() = Vec3(r * ce * b.east, r * ce * b.north, r * se) + in.sensor_position;
+    Mat3 J;
+    J << ce * b.east, r * ce * b.d_east, -r * se * b.east,
+         ce * b.north, r * ce * b.d_north, -r * se * b.north,
+         se, 0.0, r * ce;
     m_.covariance.resize(n, n);
     if (n == 4) {
       m_.value(3) = in.value(3);
