@@ -4,6 +4,7 @@
 #include <trackflow/geometry.hpp>
 #include <trackflow/spherical_measurement.hpp>
 
+#include <algorithm>
 #include <cmath>
 
 namespace trackflow::ukf {
@@ -139,8 +140,31 @@ class SphericalNearCentre {
 
  private:
   // small_atan's series over arrays of t = num / den (no check: the caller redoes the points
-  // outside its range).
+  // outside its range), cut after the first term below 2^-56 of the result for the largest |t|
+  // of the batch: t^6 / 7 for |t| <= 1e-3 (sigma points within a few kilometres at 1000 km and
+  // more), t^10 / 11 for |t| <= 0.0158, else the full series up to t^17 / 17.
   static void series_atan(const double* t_in, double* out, int n) {
+    double t2max = 0.0;
+    for (int k = 0; k < n; ++k) t2max = std::max(t2max, t_in[k] * t_in[k]);
+    if (t2max <= 1e-6) {
+      for (int k = 0; k < n; ++k) {
+        const double t = t_in[k], t2 = t * t;
+        out[k] = t * ((0.2 * t2 - 1.0 / 3.0) * t2 + 1.0);
+      }
+      return;
+    }
+    if (t2max <= 2.5e-4) {
+      for (int k = 0; k < n; ++k) {
+        const double t = t_in[k], t2 = t * t;
+        double p = 1.0 / 9.0;
+        p = p * t2 - 1.0 / 7.0;
+        p = p * t2 + 1.0 / 5.0;
+        p = p * t2 - 1.0 / 3.0;
+        p = p * t2 + 1.0;
+        out[k] = t * p;
+      }
+      return;
+    }
     for (int k = 0; k < n; ++k) {
       const double t = t_in[k], t2 = t * t;
       double p = 1.0 / 17.0;

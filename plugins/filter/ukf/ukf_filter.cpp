@@ -94,21 +94,22 @@ class UnscentedKalmanFilter final
       for (int k = 0; k < kRead && !moves; ++k) moves = idx_[k] >= j && L(idx_[k], j) != 0.0;
       slot[j] = moves ? points.count : -1;
       if (!moves) continue;
-      for (const double sign : {c, -c}) {
-        const int k = points.count++;
-        points.ex[k] = sign * L(idx_[0], j);
-        points.ey[k] = sign * L(idx_[1], j);
-        points.ez[k] = sign * L(idx_[2], j);
-        points.fx[k] = sign * L(idx_[3], j);
-        points.fy[k] = sign * L(idx_[4], j);
-        points.fz[k] = sign * L(idx_[5], j);
-      }
+      // x - c L_j: the negated offsets of x + c L_j ((-c) a = -(c a) exactly).
+      const int k = points.count;
+      points.count += 2;
+      points.ex[k + 1] = -(points.ex[k] = c * L(idx_[0], j));
+      points.ey[k + 1] = -(points.ey[k] = c * L(idx_[1], j));
+      points.ez[k + 1] = -(points.ez[k] = c * L(idx_[2], j));
+      points.fx[k + 1] = -(points.fx[k] = c * L(idx_[3], j));
+      points.fy[k + 1] = -(points.fy[k] = c * L(idx_[4], j));
+      points.fz[k + 1] = -(points.fz[k] = c * L(idx_[5], j));
     }
     near.evaluate(points);
-    SphericalVec<M> zp[N], zm[N];
+    const SphericalVec<M>* zp[N];
+    const SphericalVec<M>* zm[N];
     for (int j = 0; j < N; ++j) {
-      zp[j] = slot[j] < 0 ? near.centre() : points.z[slot[j]];
-      zm[j] = slot[j] < 0 ? near.centre() : points.z[slot[j] + 1];
+      zp[j] = slot[j] < 0 ? &near.centre() : &points.z[slot[j]];
+      zm[j] = slot[j] < 0 ? &near.centre() : &points.z[slot[j] + 1];
     }
     ukf::MeasurementMoments<N, M> ut;
     ukf::moments_from_points<N, M>(near.centre(), zp, zm, L, weights_, ut, false);

@@ -117,7 +117,8 @@ class RadarSource final : public Component, public RunResultCodec {
   }
 
   void on_truth(const Truth& t, int) override {
-    if (received_++ % every_ != 0) return;
+    // (every = 1, the default, skips the division.)
+    if (every_ != 1 && received_++ % every_ != 0) return;
     if (!t.position.allFinite() || !t.velocity.allFinite() || !std::isfinite(t.time)) {
       if (diagnostics_) diagnostics_->skip(node_, "truth at t = " + std::to_string(t.time) + " is not finite; no measurement");
       return;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <map>
 #include <iterator>
 #include <string>
 
@@ -71,6 +72,43 @@ std::unique_ptr<MetricsRunResult> load(ByteReader& in) {
   return r;
 }
 
+namespace {
+
+constexpr std::size_t kNoStep = static_cast<std::size_t>(-1);
+
+// Index of the step `key` in `steps`, or kNoStep. Records come in time order, so the step is
+// nearly always the previous record's (`cursor`) or the next; otherwise a binary search.
+std::size_t find_step(const StepList& steps, long long key, std::size_t cursor) {
+  const std::size_t n = steps.size();
+  if (cursor < n && steps[cursor].first == key) return cursor;
+  if (cursor + 1 < n && steps[cursor + 1].first == key) return cursor + 1;
+  const auto it = std::lower_bound(steps.begin(), steps.end(), key,
+                                   [](const std::pair<long long, StepSums>& s, long long k) { return s.first < k; });
+  return it != steps.end() && it->first == key ? static_cast<std::size_t>(it - steps.begin()) : kNoStep;
+}
+
+// Adds the keys in `missing` (any order, repeats allowed) as empty steps, keeping key order: one
+// merge of two sorted lists, so a run with new steps costs linear time wherever they fall.
+void insert_steps(StepList& steps, std::vector<long long>& missing) {
+  std::sort(missing.begin(), missing.end());
+  missing.erase(std::unique(missing.begin(), missing.end()), missing.end());
+  if (steps.empty() || missing.front() > steps.back().first) {
+    for (long long k : missing) steps.emplace_back(k, StepSums{});
+    return;
+  }
+  StepList merged;
+  merged.reserve(steps.size() + missing.size());
+  std::size_t i = 0;
+  for (long long k : missing) {
+    while (i < steps.size() && steps[i].first < k) merged.push_back(std::move(steps[i++]));
+    merged.emplace_back(k, StepSums{});
+  }
+  while (i < steps.size()) merged.push_back(std::move(steps[i++]));
+  steps.swap(merged);
+}
+
+}  // namespace
+
 void Ensemble::add(const MetricsRunResult& run) {
   ++runs;
   runs_with_truth += run.had_truth ? 1 : 0;
@@ -81,13 +119,31 @@ void Ensemble::add(const MetricsRunResult& run) {
   measurement_sq_error += run.measurement_sq_error;
   measurements_matched += run.measurements_matched;
   measurements_unmatched += run.measurements_unmatched;
-  // Records come in time order and every run has (nearly) the same steps: the step after the
-  // previous record's is the hint, which makes each lookup or insertion O(1) instead of O(log n).
-  auto hint = steps.begin();
+  // Steps this run reaches for the first time are created before anything is added, so every
+  // step's sums grow in run order and, within a run, in record order (estimates, then
+  // measurements), as with a map.
+  missing_.clear();
+  std::size_t cursor = 0;
   for (const EstimateRecord& r : run.records) {
-    const auto it = steps.try_emplace(hint, r.key);
-    hint = std::next(it);
-    StepSums& s = it->second;
+    const std::size_t i = find_step(steps, r.key, cursor);
+    if (i == kNoStep)
+      missing_.push_back(r.key);
+    else
+      cursor = i;
+  }
+  cursor = 0;
+  for (const MeasurementRecord& m : run.measurement_records) {
+    const std::size_t i = find_step(steps, m.key, cursor);
+    if (i == kNoStep)
+      missing_.push_back(m.key);
+    else
+      cursor = i;
+  }
+  if (!missing_.empty()) insert_steps(steps, missing_);
+  cursor = 0;
+  for (const EstimateRecord& r : run.records) {
+    cursor = find_step(steps, r.key, cursor);
+    StepSums& s = steps[cursor].second;
     if (!s.has_time) {
       s.time = r.time;
       s.has_time = true;
@@ -123,11 +179,10 @@ void Ensemble::add(const MetricsRunResult& run) {
       }
     }
   }
-  hint = steps.begin();
+  cursor = 0;
   for (const MeasurementRecord& m : run.measurement_records) {
-    const auto it = steps.try_emplace(hint, m.key);
-    hint = std::next(it);
-    StepSums& s = it->second;
+    cursor = find_step(steps, m.key, cursor);
+    StepSums& s = steps[cursor].second;
     if (!s.has_time) {
       s.time = m.time;
       s.has_time = true;

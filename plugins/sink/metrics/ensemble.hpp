@@ -7,7 +7,7 @@
 #include <trackflow/run_result_codec.hpp>
 
 #include <cstdint>
-#include <map>
+#include <utility>
 #include <vector>
 
 namespace trackflow::metrics {
@@ -71,9 +71,13 @@ struct StepSums {
   double nis = 0.0;
 };
 
+// The time steps in key order (as a std::map iterates them), in one array: a run's records find
+// their step from the previous record's (records come in time order), with no tree to walk.
+using StepList = std::vector<std::pair<long long, StepSums>>;
+
 // Everything merge() accumulates; add() must be called in run order for reproducible sums.
 struct Ensemble {
-  std::map<long long, StepSums> steps;
+  StepList steps;
   std::uint64_t runs = 0, runs_with_truth = 0;
   std::uint64_t estimates = 0, before_window = 0, non_finite = 0, unmatched = 0, not_positive_definite = 0;
   double measurement_sq_error = 0.0;
@@ -84,6 +88,9 @@ struct Ensemble {
   int annotation_channels = 0;
 
   void add(const MetricsRunResult& run);
+
+ private:
+  std::vector<long long> missing_;  // add()'s scratch: keys of the run not yet in steps
 };
 
 struct ReportOptions {

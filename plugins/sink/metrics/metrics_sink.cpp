@@ -56,12 +56,16 @@ class MetricsSink final : public Component, public RunResultCodec {
   }
 
   void start_run(const RunContext&) override {
+    truth_nan_time_ = false;
     truth_.clear();
     estimates_.clear();
     measurements_.clear();
   }
 
-  void on_truth(const Truth& t, int) override { metrics::insert_truth(truth_, t); }
+  void on_truth(const Truth& t, int) override {
+    truth_nan_time_ = truth_nan_time_ || std::isnan(t.time);
+    metrics::insert_truth(truth_, t);
+  }
 
   // Every estimate is kept (uninitialised ones only count towards the per-step fractions).
   void on_estimate(const Estimate& e, int) override {
@@ -93,6 +97,9 @@ class MetricsSink final : public Component, public RunResultCodec {
     r->records.reserve(estimates_.size());
     r->measurement_records.reserve(measurements_.size());
     const double start = window_start();
+    // One target whose samples are in time order: lookups walk forward from the previous one.
+    cursor_ = nullptr;
+    use_cursor_ = !truth_nan_time_ && metrics::single_target(truth_);
     for (const StoredEstimate& e : estimates_) {
       if (!std::isfinite(e.time)) {
         if (e.initialised) ++r->non_finite;
@@ -169,7 +176,8 @@ class MetricsSink final : public Component, public RunResultCodec {
       rec.innovation.head(m) = e.innovation;
     }
     Vec6 truth;
-    if (!metrics::truth_at(metrics::truth_for(truth_, e.target), e.time, tolerance_, truth)) {
+    if (!metrics::truth_at(metrics::truth_for(truth_, e.target), e.time, tolerance_, truth,
+                           use_cursor_ ? &cursor_ : nullptr)) {
       ++r.unmatched;
       return;
     }
@@ -189,10 +197,12 @@ class MetricsSink final : public Component, public RunResultCodec {
     // Measurements carry a sensor, not a target, so they can only be scored against a single truth target.
     const bool usable = metrics::single_target(truth_);
     const metrics::TruthSpan span = metrics::truth_for(truth_, 0);
+    const Truth* cursor = nullptr;
+    const Truth** from = truth_nan_time_ ? nullptr : &cursor;
     for (const auto& m : measurements_) {
       if (m.time + tolerance_ < start) continue;
       Vec6 truth;
-      if (usable && metrics::truth_at(span, m.time, tolerance_, truth)) {
+      if (usable && metrics::truth_at(span, m.time, tolerance_, truth, from)) {
         const double sq = (m.position - truth.head<3>()).squaredNorm();
         r.measurement_sq_error += sq;
         ++r.measurements_matched;
@@ -206,7 +216,11 @@ class MetricsSink final : public Component, public RunResultCodec {
   const double skip_initial_, confidence_, tolerance_;
   const bool series_;
   bool truth_input_ = false, measurement_input_ = false;
+  bool truth_nan_time_ = false;  // a truth sample without a time: samples not in time order
   std::vector<Truth> truth_;
+  // end_run's truth lookups (evaluate): where the last one ended, and whether to start there.
+  mutable const Truth* cursor_ = nullptr;
+  bool use_cursor_ = false;
   std::vector<StoredEstimate> estimates_;
   std::vector<StoredMeasurement> measurements_;
   metrics::AnnotationChannels channels_;

@@ -44,10 +44,22 @@ inline bool single_target(const std::vector<Truth>& samples) {
 
 // [position; velocity] at time t: the closest sample within `tolerance`, else linear
 // interpolation between the two samples that bracket t. False outside the span of the samples.
-inline bool truth_at(TruthSpan span, double t, double tolerance, Vec6& state) {
+//
+// `from` (optional) is for a caller that looks up nondecreasing times in samples known to be in
+// time order (no NaN time): the previous lookup's position, from which the first sample at or
+// after t - tolerance is found by a forward walk -- the sample the binary search finds, in one
+// or two steps at a fixed rate. A lookup earlier than the last falls back to the binary search.
+inline bool truth_at(TruthSpan span, double t, double tolerance, Vec6& state, const Truth** from = nullptr) {
   if (span.begin == span.end) return false;
-  const Truth* it = std::lower_bound(span.begin, span.end, t - tolerance,
-                                     [](const Truth& s, double time) { return s.time < time; });
+  const double lo = t - tolerance;
+  const Truth* it;
+  if (from && *from && *from >= span.begin && *from <= span.end && (*from == span.begin || (*from - 1)->time < lo)) {
+    it = *from;
+    while (it != span.end && it->time < lo) ++it;
+  } else {
+    it = std::lower_bound(span.begin, span.end, lo, [](const Truth& s, double time) { return s.time < time; });
+  }
+  if (from) *from = it;
   if (it != span.end && it->time <= t + tolerance) {
     const Truth* best = it;
     for (const Truth* p = it + 1; p != span.end && p->time <= t + tolerance; ++p)
