@@ -57,6 +57,14 @@ inline std::vector<ParamSpec> motion_param_specs() {
   };
 }
 
+inline ParamSpec zenith_param() {
+  using Zenith = Settings::Zenith;
+  return ParamSpec::choice<Zenith>("zenith", {{Zenith::Curvature, "curvature"}, {Zenith::Textbook, "textbook"}},
+                                   "near the zenith: add the angles' curvature variance to R and drop the azimuth within "
+                                   "3 sigma of it (curvature), or the textbook EKF (textbook)")
+      .def("curvature");
+}
+
 inline ParamSpec initial_sigma_acceleration_param() {
   return ParamSpec::real("initial_sigma_acceleration", dim::acceleration,
                          "CA/Singer, two_point or explicit: initial acceleration std (default 50 m/s2; Singer: singer_sigma)")

@@ -31,11 +31,10 @@ class CartesianRadarFilter : public FilterFrontEnd<CartesianRadarFilter<Order, D
   friend FrontEnd;
 
  public:
-  using Layout = KinematicModel<Order>;
-  static constexpr int N = Layout::kDim;
-  using StateN = typename Layout::State;
-  using MatN = typename Layout::Matrix;
-  using AxisMatrix = typename Layout::AxisMatrix;
+  using typename State::Layout;
+  using State::N;
+  using typename State::StateN;
+  using typename State::MatN;
 
   NoiseHandles noise() override {
     NoiseHandles h;

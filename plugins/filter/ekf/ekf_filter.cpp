@@ -96,11 +96,7 @@ void register_components(Registrar& r) {
   d.produces = mask(ItemKind::Estimate);
   d.accepts_frames = mask(Frame::Spherical);
   d.params = cartesian_filter::param_specs();
-  using Zenith = cartesian_filter::Settings::Zenith;
-  d.params.push_back(ParamSpec::choice<Zenith>("zenith", {{Zenith::Curvature, "curvature"}, {Zenith::Textbook, "textbook"}},
-                                               "near the zenith: add the angles' curvature variance to R and drop the "
-                                               "azimuth within 3 sigma of it (curvature), or the textbook EKF (textbook)")
-                         .def("curvature"));
+  d.params.push_back(cartesian_filter::zenith_param());
   d.create = create;
   r.add(std::move(d));
 }

@@ -363,7 +363,6 @@ void register_components(Registrar& r) {
   d.accepts = mask(ItemKind::Measurement);
   d.produces = mask(ItemKind::Estimate);
   d.accepts_frames = mask(Frame::Spherical);
-  using Zenith = Settings::Zenith;
   d.params = {
       ParamSpec::records("modes", mode_fields(), "the mode filters (2 to 4): motion model and its noise each").req(),
       ParamSpec::real_list("transition", dim::none,
@@ -372,9 +371,7 @@ void register_components(Registrar& r) {
           .req(),
       ParamSpec::real_list("initial_probabilities", dim::none, "mode probabilities at the start (default: uniform)"),
       range_rate_param(),
-      ParamSpec::choice<Zenith>("zenith", {{Zenith::Curvature, "curvature"}, {Zenith::Textbook, "textbook"}},
-                                "near the zenith, in every mode: as filter.ekf's zenith parameter")
-          .def("curvature"),
+      cartesian_filter::zenith_param(),
   };
   d.create = create;
   r.add(std::move(d));

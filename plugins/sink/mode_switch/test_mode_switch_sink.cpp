@@ -26,15 +26,14 @@ void feed(Component& sink, std::uint64_t run, Value value) {
     e.annotations[1] = value(k);
     sink.on_estimate(e, 0);
   }
-  auto r = sink.end_run();
-  sink.merge(*r);
+  std::unique_ptr<RunResult> result = sink.end_run();
+  sink.merge(*result);
 }
 
-double metric(const Summary& s, const char* name) {
+// A missing metric reads as -1, which no check below accepts.
+double metric(const Summary& s, const std::string& name) {
   const Metric* m = s.find(name);
-  INFO(name);
-  REQUIRE(m);
-  return m->value;
+  return m ? m->value : -1.0;
 }
 
 std::vector<InputInfo> inputs() { return {{"imm", "filter.imm", mask(ItemKind::Estimate), {"imm.p_cv", "imm.p_ca"}}}; }
