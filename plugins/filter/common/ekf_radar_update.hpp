@@ -24,6 +24,7 @@ struct EkfInnovation {
   Eigen::Matrix<double, M, 1> nu;
   Eigen::Matrix<double, M, M> S;
   double nis = 0.0;
+  double det_S = 0.0;  // det S, from the update's Cholesky factor
   bool azimuth_dropped = false, azimuth_deweighted = false;
 };
 
@@ -92,7 +93,7 @@ EkfOutcome ekf_radar_update(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double
       S(l, k) = s;
     }
   out.nu = nu;
-  if (joseph_update_cross<N, M>(x, P, nu, PHt, S, out.nis)) return EkfOutcome::Used;
+  if (joseph_update_cross<N, M>(x, P, nu, PHt, S, out.nis, nullptr, &out.det_S)) return EkfOutcome::Used;
   return EkfOutcome::NotPositiveDefinite;
 }
 

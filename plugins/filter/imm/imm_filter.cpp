@@ -7,8 +7,6 @@
 #include <trackflow/filter_front_end.hpp>
 #include <trackflow/plugin.hpp>
 
-#include <Eigen/Cholesky>
-
 #include <array>
 #include <cmath>
 #include <limits>
@@ -72,6 +70,7 @@ class ImmFilter final : public FilterFrontEnd<ImmFilter> {
       modes_[j] = c.modes[static_cast<size_t>(j)];
       mu0_[j] = c.initial[static_cast<size_t>(j)];
       any_acceleration_ = any_acceleration_ || modes_[j].order == 3;
+      all_acceleration_ = all_acceleration_ && modes_[j].order == 3;
       for (int i = 0; i < count_; ++i) pi_[j * count_ + i] = c.transition[static_cast<size_t>(j * count_ + i)];
     }
     const int n = any_acceleration_ ? 9 : 6;
@@ -113,19 +112,39 @@ class ImmFilter final : public FilterFrontEnd<ImmFilter> {
     return formed;
   }
 
-  // Interaction (mixing) on the common state, then each mode's own exact prediction.
+  // Interaction (mixing) on the common state, then each mode's own exact prediction. All mixed
+  // starts are formed before any mode is overwritten.
   void predict(double T) {
     imm::mixing_weights(pi_, mu_, count_, c_, w_);
-    for (int i = 0; i < count_; ++i) visit(modes_[i], [&](auto& s) { imm::to_common<order_of<decltype(s)>>(s.x_, s.P_, common_[i]); });
+    const imm::ModeView& v = view();
     for (int j = 0; j < count_; ++j) {
-      // A receiver with acceleration lends its own to the modes without (imm_mixing.hpp).
-      imm::mix(common_, w_[j], count_, common_[j].x, common_[j].P, modes_[j].order == 3, x0_, P0_);
+      // A receiver with acceleration lends its own to the modes without (imm_mixing.hpp); a CV
+      // receiver keeps only the position and velocity of the mixture.
+      imm::mix(v, w_[j], *v.x[j], *v.P[j], x0s_[j], P0s_[j]);
+    }
+    for (int j = 0; j < count_; ++j)
       visit(modes_[j], [&](auto& s) {
-        imm::from_common<order_of<decltype(s)>>(x0_, P0_, s.x_, s.P_);
+        imm::from_common<order_of<decltype(s)>>(x0s_[j], P0s_[j], s.x_, s.P_);
         s.predict_state(T, same_interval(T, s.last_interval()));
       });
-    }
     mixed_ = true;
+  }
+
+  // The modes on the common state: a 9-state mode as it is, a CV mode through a copy.
+  const imm::ModeView& view() const {
+    view_.count = count_;
+    for (int i = 0; i < count_; ++i) {
+      if (modes_[i].order == 3) {
+        view_.x[i] = &modes_[i].ca.x_;
+        view_.P[i] = &modes_[i].ca.P_;
+      } else {
+        imm::to_common<2>(modes_[i].cv.x_, modes_[i].cv.P_, common_[i]);
+        view_.x[i] = &common_[i].x;
+        view_.P[i] = &common_[i].P;
+      }
+      view_.has_acceleration[i] = modes_[i].order == 3;
+    }
+    return view_;
   }
 
   template <int M>
@@ -144,7 +163,7 @@ class ImmFilter final : public FilterFrontEnd<ImmFilter> {
       });
       used[j] = outcome == cartesian_filter::EkfOutcome::Used;
       dropped = dropped || innovation<M>(j).azimuth_dropped;
-      ll[j] = used[j] ? imm::log_likelihood<M>(innovation<M>(j).S, innovation<M>(j).nis)
+      ll[j] = used[j] ? imm::log_likelihood(M, innovation<M>(j).nis, innovation<M>(j).det_S)
                       : -std::numeric_limits<double>::infinity();
       if (!used[j]) count(kModeRefused);
       if (used[j] && std::isfinite(ll[j])) {
@@ -187,8 +206,8 @@ class ImmFilter final : public FilterFrontEnd<ImmFilter> {
         const VecM d = innovation<M>(j).nu - nu;
         S += (c_[j] / total) * (innovation<M>(j).S + d * d.transpose());
       }
-    const Eigen::LLT<MatM> llt(S);
-    const double nis = llt.info() == Eigen::Success ? nu.dot(llt.solve(nu)) : 0.0;
+    double nis = 0.0;
+    if (!imm::quadratic_form<M>(S, nu, nis)) nis = 0.0;  // a mixture of PD matrices is PD: not reached
     accept_update<M>(nu, S, nis);
   }
 
@@ -199,13 +218,12 @@ class ImmFilter final : public FilterFrontEnd<ImmFilter> {
   // The combined estimate, moment-matched on the common state. The acceleration of a mode
   // without one is the probability-weighted acceleration of the modes that carry it.
   void fill_estimate(Estimate& e) const {
-    for (int i = 0; i < count_; ++i)
-      visit(modes_[i], [&](const auto& s) { imm::to_common<order_of<decltype(s)>>(s.x_, s.P_, common_[i]); });
+    const imm::ModeView& v = view();
+    // Every mode mixed into the reference has its own acceleration, so the reference passed to
+    // that mixture is never read.
     imm::VecC ref_x = imm::VecC::Zero();
     imm::MatC ref_P = imm::MatC::Zero();
-    const imm::VecC unused_x = imm::VecC::Zero();  // every mode mixed into the reference has its own
-    const imm::MatC unused_P = imm::MatC::Zero();
-    if (any_acceleration_) {
+    if (any_acceleration_ && !all_acceleration_) {
       double wa[kMaxModes] = {}, total = 0.0;
       for (int i = 0; i < count_; ++i)
         if (modes_[i].order == 3) total += mu_[i];
@@ -214,9 +232,11 @@ class ImmFilter final : public FilterFrontEnd<ImmFilter> {
       double sum = 0.0;
       for (int i = 0; i < count_; ++i) sum += wa[i];
       for (int i = 0; i < count_; ++i) wa[i] /= sum;
-      imm::mix(common_, wa, count_, unused_x, unused_P, true, ref_x, ref_P);
+      imm::mix(v, wa, ref_x, ref_P, x0_, P0_);
+      ref_x = x0_;
+      ref_P = P0_;
     }
-    imm::mix(common_, mu_, count_, ref_x, ref_P, any_acceleration_, x0_, P0_);
+    imm::mix(v, mu_, ref_x, ref_P, x0_, P0_);
     const int n = any_acceleration_ ? 9 : 6;
     e.state.resize(n);
     e.covariance.resize(n, n);
@@ -263,14 +283,17 @@ class ImmFilter final : public FilterFrontEnd<ImmFilter> {
 
   int count_ = 0;
   std::array<Mode, kMaxModes> modes_;
-  bool any_acceleration_ = false, mixed_ = false;
+  bool any_acceleration_ = false, all_acceleration_ = true, mixed_ = false;
   double pi_[kMaxModes * kMaxModes] = {};  // row i: from mode i
   double mu0_[kMaxModes] = {}, mu_[kMaxModes] = {}, c_[kMaxModes] = {};
   double w_[kMaxModes][kMaxModes] = {};  // w_[j][i]: weight of mode i in mode j's mixed start
   cartesian_filter::EkfInnovation<3> in3_[kMaxModes];
   cartesian_filter::EkfInnovation<4> in4_[kMaxModes];
   // Scratch (fill_estimate is const: what it forms is no state of the filter).
-  mutable imm::CommonEstimate common_[kMaxModes];
+  mutable imm::CommonEstimate common_[kMaxModes];  // CV modes on the common state
+  mutable imm::ModeView view_;
+  imm::VecC x0s_[kMaxModes];  // mixed starts
+  imm::MatC P0s_[kMaxModes];
   mutable imm::VecC x0_ = imm::VecC::Zero();
   mutable imm::MatC P0_ = imm::MatC::Zero();
 };

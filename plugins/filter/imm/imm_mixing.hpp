@@ -27,7 +27,7 @@ constexpr int common_index(int i) {
 constexpr bool is_acceleration(int c) { return c % 3 == 2; }
 
 // A mode's estimate on the common state; without acceleration (CV) its acceleration entries are
-// left as they are and has_acceleration is false.
+// zero and has_acceleration is false.
 struct CommonEstimate {
   VecC x = VecC::Zero();
   MatC P = MatC::Zero();
@@ -42,6 +42,8 @@ void to_common(const Eigen::Matrix<double, 3 * Order, 1>& x, const Eigen::Matrix
     out.x = x;
     out.P = P;
   } else {
+    out.x.setZero();
+    out.P.setZero();
     for (int i = 0; i < N; ++i) {
       out.x(common_index<Order>(i)) = x(i);
       for (int j = 0; j < N; ++j) out.P(common_index<Order>(i), common_index<Order>(j)) = P(i, j);
@@ -65,47 +67,66 @@ void from_common(const VecC& xc, const MatC& Pc, Eigen::Matrix<double, 3 * Order
   }
 }
 
+// The modes as mix() reads them: states on the common layout, by pointer (a 9-state mode's own
+// x and P need no copy); a mode without acceleration has zero acceleration entries in x and P.
+struct ModeView {
+  const VecC* x[kMaxModes] = {};
+  const MatC* P[kMaxModes] = {};
+  bool has_acceleration[kMaxModes] = {};
+  int count = 0;
+};
+
 // Moment-matched mixture sum_i w_i N(x_i, P_i) on the common state (weights sum to 1; zero
 // weights are skipped). A mode without acceleration has none to contribute: its acceleration is
 // taken as the reference's (ref_x, ref_P acceleration entries), uncorrelated with its position
 // and velocity — the "unbiased mixing" of Granström, Willett & Bar-Shalom (2015): augmenting with
 // zero would pull the receiving mode's acceleration towards zero by the CV weight at every step,
 // a bias no model asked for. Position and velocity are mixed exactly whatever the reference.
-// Only the upper triangle is summed, then mirrored. acceleration: whether to form the
-// acceleration entries at all (a CV receiver needs only position and velocity).
-inline void mix(const CommonEstimate* modes, const double* w, int count, const VecC& ref_x, const MatC& ref_P,
-                bool acceleration, VecC& x, MatC& P) {
-  VecC xi[kMaxModes];
-  for (int i = 0; i < count; ++i) {
-    xi[i] = modes[i].x;
-    if (!modes[i].has_acceleration)
-      for (int a = 0; a < 3; ++a) xi[i](3 * a + 2) = ref_x(3 * a + 2);
+// The upper triangle is summed column by column (contiguous, no branch: it vectorises), then
+// mirrored.
+inline void mix(const ModeView& modes, const double* w, const VecC& ref_x, const MatC& ref_P, VecC& x, MatC& P) {
+  VecC borrowed[kMaxModes];
+  const VecC* xi[kMaxModes];
+  for (int i = 0; i < modes.count; ++i) {
+    xi[i] = modes.x[i];
+    if (!modes.has_acceleration[i]) {
+      borrowed[i] = *modes.x[i];
+      for (int a = 0; a < 3; ++a) borrowed[i](3 * a + 2) = ref_x(3 * a + 2);
+      xi[i] = &borrowed[i];
+    }
   }
   x.setZero();
-  for (int i = 0; i < count; ++i)
-    if (w[i] > 0.0) x += w[i] * xi[i];
+  for (int i = 0; i < modes.count; ++i)
+    if (w[i] > 0.0) x += w[i] * *xi[i];
   P.setZero();
-  for (int i = 0; i < count; ++i) {
+  for (int i = 0; i < modes.count; ++i) {
     if (!(w[i] > 0.0)) continue;
-    const VecC d = xi[i] - x;
-    const bool own = modes[i].has_acceleration;
+    const double wi = w[i];
+    const VecC d = *xi[i] - x;
+    const MatC& Pi = *modes.P[i];
     for (int c = 0; c < kC; ++c) {
-      if (!acceleration && is_acceleration(c)) continue;
-      for (int r = 0; r <= c; ++r) {
-        if (!acceleration && is_acceleration(r)) continue;
-        double p;
-        if (own || (!is_acceleration(r) && !is_acceleration(c)))
-          p = modes[i].P(r, c);
-        else if (is_acceleration(r) && is_acceleration(c))
-          p = ref_P(r, c);
-        else
-          p = 0.0;  // the borrowed acceleration is uncorrelated with the mode's own states
-        P(r, c) += w[i] * (p + d(r) * d(c));
-      }
+      const double wd = wi * d(c);
+      for (int r = 0; r <= c; ++r) P(r, c) += wi * Pi(r, c) + wd * d(r);
     }
+    if (!modes.has_acceleration[i])  // the borrowed acceleration's covariance (its own entries are zero)
+      for (int b = 0; b < 3; ++b)
+        for (int a = 0; a <= b; ++a) P(3 * a + 2, 3 * b + 2) += wi * ref_P(3 * a + 2, 3 * b + 2);
   }
   for (int c = 0; c < kC; ++c)
     for (int r = 0; r < c; ++r) P(c, r) = P(r, c);
+}
+
+// The same from CommonEstimate copies.
+inline void mix(const CommonEstimate* modes, const double* w, int count, const VecC& ref_x, const MatC& ref_P, VecC& x,
+                MatC& P) {
+  ModeView v;
+  v.count = count;
+  for (int i = 0; i < count; ++i) {
+    v.x[i] = &modes[i].x;
+    v.P[i] = &modes[i].P;
+    v.has_acceleration[i] = modes[i].has_acceleration;
+  }
+  mix(v, w, ref_x, ref_P, x, P);
 }
 
 // Transition matrix (row-major, rows "from", columns "to"): count x count, entries in [0, 1],
@@ -140,26 +161,37 @@ inline void mixing_weights(const double* pi, const double* mu, int count, double
   }
 }
 
-// Gaussian log-likelihood of an innovation: -1/2 (nis + log det S + M log 2 pi), log det S from
-// its Cholesky factor. -inf when S is not positive definite.
-template <int M>
-double log_likelihood(const Eigen::Matrix<double, M, M>& S, double nis) {
-  double logdet = 0.0;
-  Eigen::Matrix<double, M, M> L = S;  // lower triangle overwritten by the factor
-  for (int j = 0; j < M; ++j) {
-    double d = L(j, j);
-    for (int k = 0; k < j; ++k) d -= L(j, k) * L(j, k);
-    if (!(d > 0.0)) return -std::numeric_limits<double>::infinity();
-    L(j, j) = std::sqrt(d);
-    logdet += 2.0 * std::log(L(j, j));
-    for (int i = j + 1; i < M; ++i) {
-      double s = L(i, j);
-      for (int k = 0; k < j; ++k) s -= L(i, k) * L(j, k);
-      L(i, j) = s / L(j, j);
-    }
-  }
+// Gaussian log-likelihood of an innovation with NIS nu' S^-1 nu and det S (both from the update's
+// Cholesky factor of S): -1/2 (nis + ln det S + M ln 2 pi). -inf unless det S > 0.
+inline double log_likelihood(int M, double nis, double det_S) {
+  if (!(det_S > 0.0)) return -std::numeric_limits<double>::infinity();
   constexpr double kLog2Pi = 1.8378770664093454836;
-  return -0.5 * (nis + logdet + M * kLog2Pi);
+  return -0.5 * (nis + std::log(det_S) + M * kLog2Pi);
+}
+
+// nu' S^-1 nu for a symmetric positive definite M x M S (Cholesky, unrolled for M <= 4); false
+// when S is not positive definite.
+template <int M>
+bool quadratic_form(const Eigen::Matrix<double, M, M>& S, const Eigen::Matrix<double, M, 1>& nu, double& nis) {
+  double L[M][M] = {}, y[M];
+  nis = 0.0;
+  for (int j = 0; j < M; ++j) {
+    double d = S(j, j);
+    for (int k = 0; k < j; ++k) d -= L[j][k] * L[j][k];
+    if (!(d > 0.0)) return false;
+    L[j][j] = std::sqrt(d);
+    const double inv = 1.0 / L[j][j];
+    for (int i = j + 1; i < M; ++i) {
+      double s = S(i, j);
+      for (int k = 0; k < j; ++k) s -= L[i][k] * L[j][k];
+      L[i][j] = s * inv;
+    }
+    double s = nu(j);  // forward substitution L y = nu, row j
+    for (int k = 0; k < j; ++k) s -= L[j][k] * y[k];
+    y[j] = s * inv;
+    nis += y[j] * y[j];
+  }
+  return true;
 }
 
 // mu_j = c_j exp(l_j) / sum_k c_k exp(l_k), in the log domain (the largest log c_j + l_j is

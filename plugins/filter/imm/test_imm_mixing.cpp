@@ -25,7 +25,7 @@ TEST_CASE("mixing two modes of equal size matches a hand computation") {
   const double w[2] = {0.25, 0.75};
   VecC x;
   MatC P;
-  mix(m, w, 2, m[0].x, m[0].P, true, x, P);
+  mix(m, w, 2, m[0].x, m[0].P, x, P);
   CHECK(x(kX) == Approx(2.5));
   // 0.25 (1 + 1.5^2) + 0.75 (2 + 0.5^2) = 0.8125 + 1.6875
   CHECK(P(kX, kX) == Approx(2.5));
@@ -58,19 +58,19 @@ TEST_CASE("a CV mode borrows the receiving mode's acceleration when mixed") {
   const double w[2] = {0.5, 0.5};
   VecC x;
   MatC P;
-  mix(m, w, 2, m[1].x, m[1].P, true, x, P);
+  mix(m, w, 2, m[1].x, m[1].P, x, P);
   CHECK(x(kX) == Approx(11.0));
   CHECK(x(kAX) == Approx(4.0));      // no pull towards zero
   CHECK(P(kAX, kAX) == Approx(2.0));  // 0.5 * 2 (borrowed) + 0.5 * 2, no spread
   CHECK(P(kX, kX) == Approx(2.5));    // 0.5 (1 + 1) + 0.5 (2 + 1)
   CHECK(P(kX, kAX) == Approx(0.15));  // only the CA mode's own cross term
   CHECK(P(kVX, kVX) == Approx(1.5));
-  // A CV receiver: position and velocity identical, no acceleration entries formed.
+  // A CV receiver (its own zero acceleration as the reference): the same position and velocity.
   VecC xr;
   MatC Pr;
-  mix(m, w, 2, m[0].x, m[0].P, false, xr, Pr);
+  mix(m, w, 2, m[0].x, m[0].P, xr, Pr);
   CHECK(Pr(kX, kX) == Approx(2.5));
-  CHECK(Pr(kAX, kAX) == 0.0);
+  CHECK(Pr(kX, kAX) == Approx(2.15));  // 0.5 * 0.3 + 0.5 (1 * 2) + 0.5 (-1 * -2): zero acceleration lent
   Eigen::Matrix<double, 6, 1> back;
   Eigen::Matrix<double, 6, 6> Pback;
   from_common<2>(xr, Pr, back, Pback);
@@ -122,11 +122,15 @@ TEST_CASE("mode probabilities in the log domain sum to 1") {
   CHECK(mu[1] == 0.25);
 }
 
-TEST_CASE("Gaussian log likelihood of an innovation") {
+TEST_CASE("Gaussian log likelihood and the quadratic form of an innovation") {
+  CHECK(log_likelihood(3, 2.0, 36.0) == Approx(-0.5 * (2.0 + std::log(36.0) + 3.0 * std::log(2.0 * std::numbers::pi))));
+  CHECK(log_likelihood(3, 2.0, 0.0) == -std::numeric_limits<double>::infinity());
   Eigen::Matrix3d S = Eigen::Vector3d(4.0, 9.0, 1.0).asDiagonal();
-  CHECK(log_likelihood<3>(S, 2.0) == Approx(-0.5 * (2.0 + std::log(36.0) + 3.0 * std::log(2.0 * std::numbers::pi))));
-  S(0, 1) = S(1, 0) = 1.0;  // det = 35
-  CHECK(log_likelihood<3>(S, 0.0) == Approx(-0.5 * (std::log(35.0) + 3.0 * std::log(2.0 * std::numbers::pi))));
+  S(0, 1) = S(1, 0) = 1.0;
+  const Eigen::Vector3d nu(1.0, -2.0, 0.5);
+  double nis = 0.0;
+  REQUIRE(quadratic_form<3>(S, nu, nis));
+  CHECK(nis == Approx(nu.dot(S.inverse() * nu)).epsilon(1e-14));
   S(0, 0) = -1.0;
-  CHECK(log_likelihood<3>(S, 0.0) == -std::numeric_limits<double>::infinity());
+  CHECK_FALSE(quadratic_form<3>(S, nu, nis));
 }
