@@ -100,7 +100,10 @@ TEST_CASE("Joseph update from P H' and S equals the dense form") {
     const Eigen::Matrix<double, 9, 4> PHt = P0 * H.transpose();
     S = H * PHt + R;
     Eigen::Matrix<double, 9, 4> K;
-    REQUIRE(joseph_update_cross<9, 4>(x, P, nu, PHt, S, nis, &K));
+    double det = 0;
+    const double det_expected = S.determinant();
+    REQUIRE(joseph_update_cross<9, 4>(x, P, nu, PHt, S, nis, &K, &det));
+    CHECK(det == Approx(det_expected).epsilon(1e-12));  // filter.imm's likelihood uses it
     CHECK((x - x_dense).norm() < 1e-12 * x_dense.norm());
     CHECK((P - P_dense).norm() < 1e-12 * P_dense.norm());
     CHECK((S - S_dense).norm() < 1e-12 * S_dense.norm());

@@ -308,6 +308,18 @@ GraphInstance instantiate_checked(const Graph& g, const PluginRegistry& registry
   // Adapters first: what they need is checked against the filter, and the filter's annotation
   // names are known before its consumers learn their inputs.
   std::vector<std::vector<std::string>> annotations(N);
+  // A filter's own annotations come first (e.g. filter.imm's mode probabilities).
+  for (size_t i = 0; i < N; ++i) {
+    auto* filter = dynamic_cast<Filter*>(inst.components[i].get());
+    if (!filter) continue;
+    const std::vector<std::string> names = filter->annotation_names();
+    if (names.empty()) continue;
+    if (!filter->reserve_own_annotations(static_cast<int>(names.size())))
+      throw ConfigError("filter '" + g.nodes[i].config.id + "' publishes " + std::to_string(names.size()) +
+                            " annotations; at most " + std::to_string(kMaxAnnotations) + " fit on an estimate",
+                        g.nodes[i].config.loc, g.nodes[i].config.id);
+    for (size_t k = 0; k < names.size(); ++k) annotations[i].push_back(qualified(g.nodes[i].config.id, names, k));
+  }
   for (size_t i = 0; i < N; ++i) {
     const GraphNode& n = g.nodes[i];
     if (n.attach_to < 0) continue;

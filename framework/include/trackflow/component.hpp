@@ -193,6 +193,10 @@ class BOOST_SYMBOL_VISIBLE Filter : public Component {
   // The noise adapters may read and overwrite, with what each number is (noise.hpp).
   virtual NoiseHandles noise() { return {}; }
   virtual StateLayout state_layout() const { return {}; }
+  // Names of values the filter itself publishes on every estimate (e.g. an IMM's mode
+  // probabilities); they come first in the estimate's annotations, before its adapters', and
+  // sinks see them as "<filter id>.<name>". Set with annotate_own().
+  virtual std::vector<std::string> annotation_names() const { return {}; }
 
   // State covariance for adapters (fading memory, inflation, re-initialisation). A filter that
   // returns true from has_covariance_access implements the three below.
@@ -209,6 +213,14 @@ class BOOST_SYMBOL_VISIBLE Filter : public Component {
     const std::uint64_t n = processed_;
     processed_ = 0;
     return n;
+  }
+  // Engine side: reserves the filter's own annotation slots (call before any attach); false when
+  // there is no room.
+  bool reserve_own_annotations(int count) {
+    if (adapter_count_ > 0 || count < 0 || annotation_count_ + count > kMaxAnnotations) return false;
+    annotation_count_ += count;
+    own_annotation_count_ += count;
+    return true;
   }
   // Engine side: attaches `a` with `annotations` values; false when there is no room.
   bool attach(Adapter* a, int annotations) {
@@ -244,6 +256,10 @@ class BOOST_SYMBOL_VISIBLE Filter : public Component {
     }
     detail::executing = this;
   }
+  // Sets the filter's own annotation `i` (index into annotation_names()) on its next estimates.
+  void annotate_own(int i, double value) {
+    if (i >= 0 && i < own_annotation_count_) annotation_values_[i] = value;
+  }
   // Whether anything sees the estimates: a consumer downstream or an adapter's after_update.
   bool observed() const { return adapter_count_ > 0 || out.count() > 0; }
   // Stamps the adapters' annotations on `e`, lets adapters see the result, then sends it on.
@@ -264,6 +280,7 @@ class BOOST_SYMBOL_VISIBLE Filter : public Component {
   Adapter* adapters_[kMaxAdapters] = {};
   int adapter_count_ = 0;
   int annotation_count_ = 0;
+  int own_annotation_count_ = 0;
   double annotation_values_[kMaxAnnotations] = {kNoAnnotation, kNoAnnotation, kNoAnnotation, kNoAnnotation,
                                                 kNoAnnotation, kNoAnnotation, kNoAnnotation, kNoAnnotation};
   double configured_[kMaxNoiseValues] = {};

@@ -50,17 +50,21 @@ bool joseph_update(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double, N, N>& 
 // construction. Multiplications: N M^2 (K = PHt S^-1) + N M^2 (K S) + N(N+1) M (P) + O(M^3),
 // e.g. about 700 for N = 9, M = 4 against about 2900 for the dense form.
 // Returns false (x, P untouched) when S is not positive definite; S is returned symmetric.
-// K, when given, receives the gain.
+// K, when given, receives the gain; det_S, when given, det S (the product of the Cholesky pivots:
+// an IMM's likelihood needs it, and the factor is at hand here).
 template <int N, int M>
 bool joseph_update_cross(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double, N, N>& P,
                          const Eigen::Matrix<double, M, 1>& nu, const Eigen::Matrix<double, N, M>& PHt,
-                         Eigen::Matrix<double, M, M>& S, double& nis, Eigen::Matrix<double, N, M>* K_out = nullptr) {
+                         Eigen::Matrix<double, M, M>& S, double& nis, Eigen::Matrix<double, N, M>* K_out = nullptr,
+                         double* det_S = nullptr) {
   // Cholesky factor of S (lower), with 1 / diagonal.
   double L[M][M] = {}, inv[M];
+  double det = 1.0;
   for (int j = 0; j < M; ++j) {
     double d = S(j, j);
     for (int k = 0; k < j; ++k) d -= L[j][k] * L[j][k];
     if (!(d > 0.0)) return false;  // also refuses NaN
+    det *= d;
     L[j][j] = std::sqrt(d);
     inv[j] = 1.0 / L[j][j];
     for (int i = j + 1; i < M; ++i) {
@@ -141,6 +145,7 @@ bool joseph_update_cross(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double, N
   if (K_out)
     for (int r = 0; r < N; ++r)
       for (int m = 0; m < M; ++m) (*K_out)(r, m) = Kc[m][r];
+  if (det_S) *det_S = det;
   return true;
 }
 

@@ -31,8 +31,8 @@ struct Settings {
   int state_dim() const { return 3 * order(); }
 };
 
-// Motion, noise, range-rate and initialisation parameters every Cartesian radar filter takes.
-inline std::vector<ParamSpec> param_specs() {
+// Motion and noise parameters: every Cartesian radar filter's, and each mode of filter.imm.
+inline std::vector<ParamSpec> motion_param_specs() {
   return {
       ParamSpec::choice<Settings::Motion>("motion",
                                           {{Settings::Motion::ConstantVelocity, "constant_velocity"},
@@ -54,6 +54,27 @@ inline std::vector<ParamSpec> param_specs() {
           .positive(),
       ParamSpec::real("singer_sigma", dim::acceleration, "singer: standard deviation sigma_m of the acceleration")
           .positive(),
+  };
+}
+
+inline ParamSpec zenith_param() {
+  using Zenith = Settings::Zenith;
+  return ParamSpec::choice<Zenith>("zenith", {{Zenith::Curvature, "curvature"}, {Zenith::Textbook, "textbook"}},
+                                   "near the zenith: add the angles' curvature variance to R and drop the azimuth within "
+                                   "3 sigma of it (curvature), or the textbook EKF (textbook)")
+      .def("curvature");
+}
+
+inline ParamSpec initial_sigma_acceleration_param() {
+  return ParamSpec::real("initial_sigma_acceleration", dim::acceleration,
+                         "CA/Singer, two_point or explicit: initial acceleration std (default 50 m/s2; Singer: singer_sigma)")
+      .positive();
+}
+
+// Motion, noise, range-rate and initialisation parameters every Cartesian radar filter takes.
+inline std::vector<ParamSpec> param_specs() {
+  std::vector<ParamSpec> specs = motion_param_specs();
+  for (ParamSpec& p : std::vector<ParamSpec>{
       range_rate_param(),
       ParamSpec::choice<Settings::Init>("init",
                                         {{Settings::Init::TwoPoint, "two_point"},
@@ -67,18 +88,16 @@ inline std::vector<ParamSpec> param_specs() {
           .def("[0, 0, 0]"),
       ParamSpec::real("initial_sigma_position", dim::length, "init explicit: position std").positive(),
       ParamSpec::real("initial_sigma_velocity", dim::velocity, "init explicit: velocity std").positive(),
-      ParamSpec::real("initial_sigma_acceleration", dim::acceleration,
-                      "CA/Singer, two_point or explicit: initial acceleration std (default 50 m/s2; Singer: singer_sigma)")
-          .positive(),
-  };
+      initial_sigma_acceleration_param(),
+  })
+    specs.push_back(std::move(p));
+  return specs;
 }
 
-// Validates the combination of the parameters above (each one alone was checked by its ParamSpec).
-inline Settings parse_settings(const Params& p, std::string type) {
+// Validates the combination of motion_param_specs() (each one alone was checked by its ParamSpec)
+// and sets the motion and noise of `s`.
+inline void parse_motion(const Params& p, Settings& s) {
   using S = Settings;
-  S s;
-  s.type = std::move(type);
-  s.node = p.node();
   s.motion = p.choice<S::Motion>("motion");
   const bool cv = s.motion == S::Motion::ConstantVelocity, ca = s.motion == S::Motion::ConstantAcceleration,
              singer = s.motion == S::Motion::Singer;
@@ -105,6 +124,16 @@ inline Settings parse_settings(const Params& p, std::string type) {
   } else {
     s.intensity = ca ? p.real("q_jerk") : p.real("q");
   }
+}
+
+// Validates the combination of the parameters of param_specs().
+inline Settings parse_settings(const Params& p, std::string type) {
+  using S = Settings;
+  S s;
+  s.type = std::move(type);
+  s.node = p.node();
+  parse_motion(p, s);
+  const bool cv = s.motion == S::Motion::ConstantVelocity, singer = s.motion == S::Motion::Singer;
 
   s.range_rate = p.choice<RangeRateUse>("range_rate");
   s.init = p.choice<S::Init>("init");

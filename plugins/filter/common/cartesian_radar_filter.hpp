@@ -1,8 +1,8 @@
-// Purpose: the Cartesian-state radar filters' common part (filter.ekf, filter.ukf): initialisation, linear prediction, noise handles and Estimate filling on the SDK front end; the derived filter supplies the update.
+// Purpose: the Cartesian-state radar filters' common part (filter.ekf, filter.ukf): the Cartesian radar state (cartesian_radar_state.hpp) on the SDK front end, with its noise handles; the derived filter supplies the update.
 #pragma once
 
 #include "cartesian_filter_settings.hpp"
-#include "three_point_init.hpp"
+#include "cartesian_radar_state.hpp"
 
 #include <trackflow/filter_front_end.hpp>
 #include <trackflow/error.hpp>
@@ -16,34 +16,33 @@
 
 namespace trackflow::cartesian_filter {
 
-// State [x vx (ax) y vy (ay) z vz (az)], Order states per axis (motion.hpp layout), absolute ENU;
-// the sensor is at rest at Measurement::sensor_position. The prediction is linear (F x,
-// F P F' + Q): the motion models are linear in Cartesian coordinates, so any filter on this state
-// predicts exactly this way; the measurement front end is the SDK's (filter_front_end.hpp).
+// A Cartesian radar state (cartesian_radar_state.hpp) behind the SDK's measurement front end
+// (filter_front_end.hpp).
 // Derived (CRTP) provides
 //   static std::vector<std::string> counter_names();   its counted events (count(i))
 //   void on_start_run();  void on_end_run_report();    its own per-run state and reports
 //   template <int M> bool correct(const Measurement&); M = 3 or 4: correct x_ and P_ with the
 //       measurement's first M values and R_.topLeftCorner(M, M); call accept_update() on success.
 template <int Order, class Derived>
-class CartesianRadarFilter : public FilterFrontEnd<CartesianRadarFilter<Order, Derived>> {
+class CartesianRadarFilter : public FilterFrontEnd<CartesianRadarFilter<Order, Derived>>,
+                             protected CartesianRadarState<Order> {
+  using State = CartesianRadarState<Order>;
   using FrontEnd = FilterFrontEnd<CartesianRadarFilter<Order, Derived>>;
   friend FrontEnd;
 
  public:
-  using Layout = KinematicModel<Order>;
-  static constexpr int N = Layout::kDim;
-  using StateN = typename Layout::State;
-  using MatN = typename Layout::Matrix;
-  using AxisMatrix = typename Layout::AxisMatrix;
+  using typename State::Layout;
+  using State::N;
+  using typename State::StateN;
+  using typename State::MatN;
 
   NoiseHandles noise() override {
     NoiseHandles h;
     h.measurement = {&this->R_, MeasurementSpace::Spherical};
-    h.process.values = q_;
+    h.process.values = this->q_;
     h.process.count = 3;
     h.process.axes = NoiseAxes::Enu;
-    switch (s_.noise) {
+    switch (this->s_.noise) {
       case Settings::Noise::Continuous:
         h.process.kind = NoiseKind::SpectralDensity;
         h.process.dimension = Order == 3 ? dim::jerk_psd : dim::accel_psd;
@@ -64,21 +63,15 @@ class CartesianRadarFilter : public FilterFrontEnd<CartesianRadarFilter<Order, D
 
  protected:
   explicit CartesianRadarFilter(Settings s)
-      : FrontEnd(FrontEndSpec{s.type, s.node, Frame::Spherical, s.range_rate, derived_counters()}), s_(std::move(s)) {
-    for (double& q : q_) q = s_.intensity;
-    for (int a = 0; a < 3; ++a) {
-      idx_[a] = Layout::position_index(a);
-      idx_[a + 3] = Layout::velocity_index(a);
-    }
+      : FrontEnd(FrontEndSpec{s.type, s.node, Frame::Spherical, s.range_rate, derived_counters()}), State(s) {
     this->est_.state.resize(N);
     this->est_.covariance.resize(N, N);
   }
 
-  const Settings& settings() const { return s_; }
-
-  StateN x_ = StateN::Zero();
-  MatN P_ = MatN::Identity();
-  int idx_[6] = {};  // state indices of [x y z vx vy vz]
+  using State::settings;
+  using State::x_;
+  using State::P_;
+  using State::idx_;
 
  private:
   Derived& derived() { return static_cast<Derived&>(*this); }
@@ -86,23 +79,8 @@ class CartesianRadarFilter : public FilterFrontEnd<CartesianRadarFilter<Order, D
 
   // Front-end hooks.
   bool reset_track() {
-    points_ = 0;
-    last_T_ = -1.0;
     derived().on_start_run();
-    if (s_.init != Settings::Init::Explicit) return false;
-    x_.setZero();
-    P_.setZero();
-    for (int a = 0; a < 3; ++a) {
-      x_(idx_[a]) = s_.p0(a);
-      x_(idx_[a + 3]) = s_.v0(a);
-      P_(idx_[a], idx_[a]) = s_.sp0 * s_.sp0;
-      P_(idx_[a + 3], idx_[a + 3]) = s_.sv0 * s_.sv0;
-      if constexpr (Order == 3) {
-        x_(a * 3 + 2) = s_.a0(a);
-        P_(a * 3 + 2, a * 3 + 2) = s_.sa0 * s_.sa0;
-      }
-    }
-    return true;
+    return this->reset_state();
   }
 
   template <int M>
@@ -114,164 +92,9 @@ class CartesianRadarFilter : public FilterFrontEnd<CartesianRadarFilter<Order, D
 
   void on_end_run() { derived().on_end_run_report(); }
 
-  void predict(double T) {
-    if (!this->same_interval(T, last_T_)) {  // fixed-rate data: F and the unit-intensity Q are computed once
-      compute_axis_model(T);
-      last_T_ = T;
-    }
-    for (int a = 0; a < 3; ++a) {
-      const Eigen::Matrix<double, Order, 1> xa = axisF_ * x_.template segment<Order>(a * Order);
-      x_.template segment<Order>(a * Order) = xa;
-    }
-    propagate_covariance();
-    for (int a = 0; a < 3; ++a) {
-      const double s = noise_scale(a);
-      for (int j = 0; j < Order; ++j)
-        for (int i = 0; i <= j; ++i) P_(a * Order + i, a * Order + j) += s * axisQ_(i, j);
-    }
-    for (int j = 0; j < N; ++j)
-      for (int i = 0; i < j; ++i) P_(j, i) = P_(i, j);
-  }
-
-  // P <- F P F' (upper triangle) with F block-diagonal and each axis block upper triangular with
-  // a unit diagonal except the last element: CV [[1, T], [0, 1]], CA and Singer
-  // [[1, f01, f02], [0, 1, f12], [0, 0, f22]]. Row operations give F P, the same on the columns
-  // of its upper triangle give F P F': 108 + 57 multiplications for CA instead of 9 dense 3x3x3
-  // block products (486) (and no symmetrisation: the lower triangle is mirrored by the caller).
-  void propagate_covariance() {
-    const double f01 = axisF_(0, 1);
-    double f02 = 0.0, f12 = 0.0, f22 = 1.0;
-    if constexpr (Order == 3) {
-      f02 = axisF_(0, 2);
-      f12 = axisF_(1, 2);
-      f22 = axisF_(2, 2);
-    }
-    for (int a = 0; a < 3; ++a) {
-      const int i = a * Order;
-      for (int c = 0; c < N; ++c) {
-        if constexpr (Order == 3) {
-          P_(i, c) += f01 * P_(i + 1, c) + f02 * P_(i + 2, c);
-          P_(i + 1, c) += f12 * P_(i + 2, c);
-          P_(i + 2, c) *= f22;
-        } else {
-          P_(i, c) += f01 * P_(i + 1, c);
-        }
-      }
-    }
-    for (int b = 0; b < 3; ++b) {
-      const int j = b * Order;
-      if constexpr (Order == 3) {
-        for (int r = 0; r <= j; ++r) P_(r, j) += f01 * P_(r, j + 1) + f02 * P_(r, j + 2);
-        for (int r = 0; r <= j + 1; ++r) P_(r, j + 1) += f12 * P_(r, j + 2);
-        for (int r = 0; r <= j + 2; ++r) P_(r, j + 2) *= f22;
-      } else {
-        for (int r = 0; r <= j; ++r) P_(r, j) += f01 * P_(r, j + 1);
-      }
-    }
-  }
-
-  void compute_axis_model(double T) {
-    if constexpr (Order == 3) {
-      if (s_.motion == Settings::Motion::Singer) {
-        axisF_ = SingerModel::axis_transition(s_.singer_alpha, T);
-        axisQ_ = (2.0 * s_.singer_alpha) * SingerModel::noise_per_psd(s_.singer_alpha, T);
-        return;
-      }
-    }
-    axisF_ = Layout::axis_transition(T);
-    axisQ_ = s_.noise == Settings::Noise::Continuous ? Layout::axis_noise_continuous(T, 1.0)
-                                                     : Layout::axis_noise_discrete(T, 1.0);
-  }
-
-  // axisQ_ is for unit intensity; q_ may be retuned by adapters between steps.
-  double noise_scale(int axis) const {
-    return s_.noise == Settings::Noise::Continuous ? q_[axis] : q_[axis] * q_[axis];
-  }
-
-  // Collects converted positions until the state can be formed: two points (two_point; paper000
-  // with CV), three (paper000 with CA/Singer).
-  bool initialise(const Measurement& m, int) {
-    if (points_ > 0 && m.time == tc_[points_ - 1]) --points_;  // same time stamp: keep the newer one
-    // Classical conversion with the exact Jacobian covariance (as convert.classical).
-    const double r = m.value(0), az = m.value(1), el = m.value(2);
-    const Mat3 J = spherical_to_enu_jacobian(r, az, el, m.azimuth);
-    const Mat3 Rs = this->R_.topLeftCorner(3, 3);
-    zc_[points_] = spherical_to_enu(r, az, el, m.azimuth) + m.sensor_position;
-    const Mat3 Rc = J * Rs * J.transpose();
-    Rc_[points_] = 0.5 * (Rc + Rc.transpose());
-    tc_[points_] = m.time;
-    ++points_;
-    const bool three = s_.init == Settings::Init::Paper000 && Order == 3;
-    if (points_ < (three ? 3 : 2)) return false;
-    x_.setZero();
-    P_.setZero();
-    if (s_.init == Settings::Init::Paper000)
-      paper000_state();
-    else
-      two_point_state();
-    return true;
-  }
-
-  // Bar-Shalom, Li & Kirubarajan 2001 §5.5.3 with the full converted covariances.
-  void two_point_state() {
-    const Vec3 &z1 = zc_[0], &z2 = zc_[1];
-    const Mat3 &R1 = Rc_[0], &R2 = Rc_[1];
-    const double T = tc_[1] - tc_[0];
-    for (int a = 0; a < 3; ++a) {
-      const int p = idx_[a], v = idx_[a + 3];
-      x_(p) = z2(a);
-      x_(v) = (z2(a) - z1(a)) / T;
-      for (int b = 0; b < 3; ++b) {
-        const int pb = idx_[b], vb = idx_[b + 3];
-        P_(p, pb) = R2(a, b);
-        P_(p, vb) = P_(vb, p) = R2(a, b) / T;
-        P_(v, vb) = (R1(a, b) + R2(a, b)) / (T * T);
-      }
-      if constexpr (Order == 3) P_(a * 3 + 2, a * 3 + 2) = s_.sa0 * s_.sa0;
-    }
-  }
-
-  // Paper 000 §IV.2.1: per axis, the covariance of finite differences of positions with
-  // variance sigma^2 (the latest converted variance of that axis); no cross-axis terms.
-  void paper000_state() {
-    for (int a = 0; a < 3; ++a) {
-      const double s2 = Rc_[points_ - 1](a, a);
-      if constexpr (Order == 3) {
-        const Eigen::Matrix3d A = three_point_differences(tc_[1] - tc_[0], tc_[2] - tc_[1]);
-        const Vec3 za(zc_[0](a), zc_[1](a), zc_[2](a));
-        x_.template segment<3>(a * 3) = A * za;
-        P_.template block<3, 3>(a * 3, a * 3) = paper000_axis_covariance(s2, tc_[1] - tc_[0], tc_[2] - tc_[1]);
-      } else {
-        const double T = tc_[1] - tc_[0];
-        x_(2 * a) = zc_[1](a);
-        x_(2 * a + 1) = (zc_[1](a) - zc_[0](a)) / T;
-        P_(2 * a, 2 * a) = s2;
-        P_(2 * a, 2 * a + 1) = P_(2 * a + 1, 2 * a) = s2 / T;
-        P_(2 * a + 1, 2 * a + 1) = 2 * s2 / (T * T);
-      }
-    }
-  }
-
-  void fill_estimate(Estimate& e) const {
-    e.state.resize(N);
-    e.state.template head<N>() = x_;
-    e.covariance.resize(N, N);
-    e.covariance.template topLeftCorner<N, N>() = P_;
-    for (int i = 0; i < 6; ++i) {
-      e.enu(i) = x_(idx_[i]);
-      for (int j = 0; j < 6; ++j) e.enu_covariance(i, j) = P_(idx_[i], idx_[j]);
-    }
-  }
-
-  Settings s_;
-  double q_[3] = {};
-  AxisMatrix axisF_ = AxisMatrix::Identity();
-  AxisMatrix axisQ_ = AxisMatrix::Zero();
-  double last_T_ = -1.0;
-  int points_ = 0;
-  Vec3 zc_[3];
-  Mat3 Rc_[3];
-  double tc_[3] = {};
+  void predict(double T) { this->predict_state(T, this->same_interval(T, this->last_interval())); }
+  bool initialise(const Measurement& m, int) { return this->add_point(m, this->R_); }
+  void fill_estimate(Estimate& e) const { this->fill_state(e); }
 };
 
 }  // namespace trackflow::cartesian_filter

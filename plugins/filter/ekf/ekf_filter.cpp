@@ -1,11 +1,9 @@
 // Purpose: filter.ekf — extended Kalman filter with a Cartesian ENU state (CV, CA or Singer motion) on spherical [r, az, el(, rdot)] measurements.
 #include "cartesian_radar_filter.hpp"
-#include "zenith_linearisation.hpp"
+#include "ekf_radar_update.hpp"
 
 #include <trackflow/geometry.hpp>
-#include <trackflow/kalman.hpp>
 #include <trackflow/plugin.hpp>
-#include <trackflow/spherical_measurement.hpp>
 
 #include <string>
 
@@ -37,84 +35,35 @@ class ExtendedKalmanFilter final
   void on_start_run() { zenith_reported_ = false; }
   void on_end_run_report() {}
 
-  // H = dh/dx is non-zero only in the position columns (and, for the range rate, the velocity
-  // columns): P H' and H P H' are formed from those (kalman.hpp, joseph_update_cross), never the
-  // M x N H or an N x N x N product.
+  // The update itself is shared with filter.imm's modes (ekf_radar_update.hpp); this is its
+  // reporting: counts, and warnings once per run.
   template <int M>
   bool correct(const Measurement& m) {
-    using MatM = Eigen::Matrix<double, M, M>;
-    const Vec3 d = Layout::position(x_) - m.sensor_position;
-    const Vec3 v = Layout::velocity(x_);
-    SphericalJacobian<M> J;  // columns [x y z vx vy vz]
-    SphericalVec<M> h;
-    const SphericalSingularity sing = spherical_measurement_with_jacobian<M>(d, v, m.azimuth, h, J);
-    if (sing == SphericalSingularity::AtSensor) {
+    cartesian_filter::EkfInnovation<M> in;
+    const bool curvature = this->settings().zenith == cartesian_filter::Settings::Zenith::Curvature;
+    const cartesian_filter::EkfOutcome outcome = cartesian_filter::ekf_radar_update<N, M>(
+        x_, P_, idx_, m, Eigen::Matrix<double, M, M>(R_.template topLeftCorner<M, M>()), curvature, in);
+    if (outcome == cartesian_filter::EkfOutcome::AtSensor) {
       this->warn("predicted position at the sensor at t=" + std::to_string(m.time) +
                  " s: no direction to linearise about; measurement not used");
       return false;
     }
-    const SphericalVec<M> z = m.value.template head<M>();
-    SphericalVec<M> nu = spherical_residual<M>(z, h);
-    MatM R = R_.template topLeftCorner<M, M>();
-    if (this->settings().zenith == cartesian_filter::Settings::Zenith::Curvature) condition_near_zenith<M>(m, d, sing, J, nu, R);
-    // Rows r, az, el depend on the position only; the range rate's also on the velocity.
-    Eigen::Matrix<double, N, M> PHt;
-    for (int k = 0; k < M; ++k)
-      for (int r = 0; r < N; ++r) {
-        double s = P_(r, idx_[0]) * J(k, 0) + P_(r, idx_[1]) * J(k, 1) + P_(r, idx_[2]) * J(k, 2);
-        if (k == 3) s += P_(r, idx_[3]) * J(k, 3) + P_(r, idx_[4]) * J(k, 4) + P_(r, idx_[5]) * J(k, 5);
-        PHt(r, k) = s;
-      }
-    MatM S;
-    for (int k = 0; k < M; ++k)
-      for (int l = k; l < M; ++l) {
-        const int c = l == 3 ? 6 : 3;  // H P H' = H (P H'): row l of H against column k of P H'
-        double s = R(l, k);
-        for (int j = 0; j < c; ++j) s += J(l, j) * PHt(idx_[j], k);
-        S(l, k) = s;
-      }
-    double nis = 0.0;
-    if (joseph_update_cross<N, M>(x_, P_, nu, PHt, S, nis)) {
-      this->template accept_update<M>(nu, S, nis);
+    if (in.azimuth_dropped) this->count(kAzimuthDropped);
+    if (in.azimuth_deweighted) this->count(kAzimuthDeweighted);
+    if (!zenith_reported_ && (in.azimuth_dropped || in.azimuth_deweighted)) {
+      this->warn("target near the zenith at t=" + std::to_string(m.time) + " s: azimuth " +
+                 (in.azimuth_dropped ? "not used" : "de-weighted") +
+                 " (its linearisation fails over the predicted uncertainty); counted in the summary, reported once "
+                 "per run");
+      zenith_reported_ = true;
+    }
+    if (outcome == cartesian_filter::EkfOutcome::Used) {
+      this->template accept_update<M>(in.nu, in.S, in.nis);
       return true;
     }
     this->warn("innovation covariance not positive definite at t=" + std::to_string(m.time) +
                " s; measurement not used");
     return false;
-  }
-
-  // Curvature of the angles over the predicted horizontal uncertainty (zenith_linearisation.hpp):
-  // negligible at ordinary ranges, it de-weights the azimuth smoothly as the target nears the
-  // zenith. When the zenith itself is within 3 sigma of the predicted horizontal position the
-  // azimuth may flip by pi and is dropped: zero row, zero innovation, R decorrelated (an
-  // infinitely uncertain azimuth; range, elevation and range rate still update).
-  template <int M>
-  void condition_near_zenith(const Measurement& m, const Vec3& d, SphericalSingularity sing, SphericalJacobian<M>& J,
-                             SphericalVec<M>& nu, Eigen::Matrix<double, M, M>& R) {
-    Eigen::Matrix2d Ph;
-    Ph << P_(idx_[0], idx_[0]), P_(idx_[0], idx_[1]), P_(idx_[1], idx_[0]), P_(idx_[1], idx_[1]);
-    const ekf::AngleCurvature curvature = ekf::angle_curvature_variance(d, Ph, kZenithFraction * d.norm());
-    const double raz = R(1, 1);
-    R(2, 2) += curvature.elevation;
-    const bool drop_azimuth = sing == SphericalSingularity::Zenith || curvature.azimuth_unusable;
-    if (drop_azimuth) {
-      J.row(1).setZero();
-      nu(1) = 0.0;
-      R.row(1).setZero();
-      R.col(1).setZero();
-      R(1, 1) = raz > 0.0 ? raz : 1.0;
-      this->count(kAzimuthDropped);
-    } else {
-      R(1, 1) += curvature.azimuth;
-      if (curvature.azimuth > raz) this->count(kAzimuthDeweighted);
-    }
-    if (!zenith_reported_ && (drop_azimuth || curvature.azimuth > raz)) {
-      this->warn("target near the zenith at t=" + std::to_string(m.time) + " s: azimuth " +
-                 (drop_azimuth ? "not used" : "de-weighted") +
-                 " (its linearisation fails over the predicted uncertainty); counted in the summary, reported once "
-                 "per run");
-      zenith_reported_ = true;
-    }
   }
 
   bool zenith_reported_ = false;
@@ -147,11 +96,7 @@ void register_components(Registrar& r) {
   d.produces = mask(ItemKind::Estimate);
   d.accepts_frames = mask(Frame::Spherical);
   d.params = cartesian_filter::param_specs();
-  using Zenith = cartesian_filter::Settings::Zenith;
-  d.params.push_back(ParamSpec::choice<Zenith>("zenith", {{Zenith::Curvature, "curvature"}, {Zenith::Textbook, "textbook"}},
-                                               "near the zenith: add the angles' curvature variance to R and drop the "
-                                               "azimuth within 3 sigma of it (curvature), or the textbook EKF (textbook)")
-                         .def("curvature"));
+  d.params.push_back(cartesian_filter::zenith_param());
   d.create = create;
   r.add(std::move(d));
 }

@@ -87,7 +87,7 @@ void ekf_jacobian(const S d[3], Mat<S, 3, 9>& H) {
   H(2, 6) = rho / r2;
 }
 
-// The arithmetic of ekf::angle_curvature_variance (plugins/filter/ekf/zenith_linearisation.hpp).
+// The arithmetic of ekf::angle_curvature_variance (plugins/filter/common/zenith_linearisation.hpp).
 template <class S>
 void ekf_curvature(const S d[3], const S Ph[2][2], S& azimuth, S& elevation) {
   using std::hypot;

@@ -44,7 +44,12 @@ class PluginFixture {
 
   std::shared_ptr<Component> make(const std::string& type, const std::string& yaml_params = "{}",
                                   const std::string& node_id = "node") const {
-    return registry_.create(*registry_.find(type), params_for(type, yaml_params, node_id));
+    std::shared_ptr<Component> c = registry_.create(*registry_.find(type), params_for(type, yaml_params, node_id));
+    // A filter's own annotations get their slots as in the engine (graph.cpp).
+    if (auto* f = dynamic_cast<Filter*>(c.get()))
+      if (!f->reserve_own_annotations(static_cast<int>(f->annotation_names().size())))
+        throw std::runtime_error("too many annotations on a " + type);
+    return c;
   }
 
  private:

@@ -1,0 +1,100 @@
+// Purpose: the EKF measurement update of a Cartesian radar state on [r, az, el(, rdot)] (filter.ekf and each mode of filter.imm): analytic Jacobian, zenith conditioning, structured Joseph update.
+#pragma once
+
+#include "zenith_linearisation.hpp"
+
+#include <trackflow/items.hpp>
+#include <trackflow/kalman.hpp>
+#include <trackflow/spherical_measurement.hpp>
+
+#include <Eigen/Core>
+
+namespace trackflow::cartesian_filter {
+
+enum class EkfOutcome {
+  Used,
+  AtSensor,             // predicted position at the sensor: no direction to linearise about
+  NotPositiveDefinite,  // S not positive definite: x and P untouched
+};
+
+// What one update saw: the innovation and its covariance (what an IMM's likelihood needs) and
+// what the zenith conditioning did.
+template <int M>
+struct EkfInnovation {
+  Eigen::Matrix<double, M, 1> nu;
+  Eigen::Matrix<double, M, M> S;
+  double nis = 0.0;
+  double det_S = 0.0;  // det S, from the update's Cholesky factor
+  bool azimuth_dropped = false, azimuth_deweighted = false;
+};
+
+// Curvature of the angles over the predicted horizontal uncertainty (zenith_linearisation.hpp):
+// negligible at ordinary ranges, it de-weights the azimuth smoothly as the target nears the
+// zenith. When the zenith itself is within 3 sigma of the predicted horizontal position the
+// azimuth may flip by pi and is dropped: zero row, zero innovation, R decorrelated (an
+// infinitely uncertain azimuth; range, elevation and range rate still update).
+template <int N, int M>
+void condition_near_zenith(const Eigen::Matrix<double, N, N>& P, const int idx[6], const Vec3& d,
+                           SphericalSingularity sing, SphericalJacobian<M>& J, SphericalVec<M>& nu,
+                           Eigen::Matrix<double, M, M>& R, EkfInnovation<M>& out) {
+  Eigen::Matrix2d Ph;
+  Ph << P(idx[0], idx[0]), P(idx[0], idx[1]), P(idx[1], idx[0]), P(idx[1], idx[1]);
+  const ekf::AngleCurvature curvature = ekf::angle_curvature_variance(d, Ph, kZenithFraction * d.norm());
+  const double raz = R(1, 1);
+  R(2, 2) += curvature.elevation;
+  out.azimuth_dropped = sing == SphericalSingularity::Zenith || curvature.azimuth_unusable;
+  if (out.azimuth_dropped) {
+    J.row(1).setZero();
+    nu(1) = 0.0;
+    R.row(1).setZero();
+    R.col(1).setZero();
+    R(1, 1) = raz > 0.0 ? raz : 1.0;
+  } else {
+    R(1, 1) += curvature.azimuth;
+    out.azimuth_deweighted = curvature.azimuth > raz;
+  }
+}
+
+// h linearised at the predicted state x (idx: the state indices of [x y z vx vy vz]); R is the
+// measurement's M x M covariance; `curvature`: condition near the zenith (filter.ekf's zenith:
+// curvature). H = dh/dx is non-zero only in the position columns (and, for the range rate, the
+// velocity columns): P H' and H P H' are formed from those (kalman.hpp, joseph_update_cross),
+// never the M x N H or an N x N x N product.
+template <int N, int M>
+EkfOutcome ekf_radar_update(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double, N, N>& P, const int idx[6],
+                            const Measurement& m, const Eigen::Matrix<double, M, M>& R_measured, bool curvature,
+                            EkfInnovation<M>& out) {
+  using MatM = Eigen::Matrix<double, M, M>;
+  out.azimuth_dropped = out.azimuth_deweighted = false;
+  const Vec3 d = Vec3(x(idx[0]), x(idx[1]), x(idx[2])) - m.sensor_position;
+  const Vec3 v(x(idx[3]), x(idx[4]), x(idx[5]));
+  SphericalJacobian<M> J;  // columns [x y z vx vy vz]
+  SphericalVec<M> h;
+  const SphericalSingularity sing = spherical_measurement_with_jacobian<M>(d, v, m.azimuth, h, J);
+  if (sing == SphericalSingularity::AtSensor) return EkfOutcome::AtSensor;
+  const SphericalVec<M> z = m.value.template head<M>();
+  SphericalVec<M> nu = spherical_residual<M>(z, h);
+  MatM R = R_measured;
+  if (curvature) condition_near_zenith<N, M>(P, idx, d, sing, J, nu, R, out);
+  // Rows r, az, el depend on the position only; the range rate's also on the velocity.
+  Eigen::Matrix<double, N, M> PHt;
+  for (int k = 0; k < M; ++k)
+    for (int r = 0; r < N; ++r) {
+      double s = P(r, idx[0]) * J(k, 0) + P(r, idx[1]) * J(k, 1) + P(r, idx[2]) * J(k, 2);
+      if (k == 3) s += P(r, idx[3]) * J(k, 3) + P(r, idx[4]) * J(k, 4) + P(r, idx[5]) * J(k, 5);
+      PHt(r, k) = s;
+    }
+  MatM& S = out.S;
+  for (int k = 0; k < M; ++k)
+    for (int l = k; l < M; ++l) {
+      const int c = l == 3 ? 6 : 3;  // H P H' = H (P H'): row l of H against column k of P H'
+      double s = R(l, k);
+      for (int j = 0; j < c; ++j) s += J(l, j) * PHt(idx[j], k);
+      S(l, k) = s;
+    }
+  out.nu = nu;
+  if (joseph_update_cross<N, M>(x, P, nu, PHt, S, out.nis, nullptr, &out.det_S)) return EkfOutcome::Used;
+  return EkfOutcome::NotPositiveDefinite;
+}
+
+}  // namespace trackflow::cartesian_filter
