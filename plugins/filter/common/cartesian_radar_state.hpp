@@ -213,7 +213,6 @@ class CartesianRadarState {
     }
   }
 
-
   Settings s_;
   double q_[3] = {};  // process-noise intensity per ENU axis (adapters may retune it)
   StateN x_ = StateN::Zero();

@@ -65,7 +65,7 @@ TEST_CASE("mode probabilities sum to 1 and follow the manoeuvre") {
   CHECK(accel_after / n_after > 0.8);
 }
 
-TEST_CASE("an IMM certain of its CV mode equals filter.ekf with that model") {
+TEST_CASE("an IMM certain of its CV mode equals filter.ekf") {
   FilterRun imm("filter.imm", imm_params("[1, 0, 0, 0, 1, 0, 0, 0, 1]", ", initial_probabilities: [1, 0, 0]"), 0, "imm");
   FilterRun ekf("filter.ekf", "{ motion: constant_velocity, q: 1 m2/s3 }", 0, "ekf");
   Rng rng(3);

@@ -35,7 +35,7 @@ TEST_CASE("mixing two modes of equal size matches a hand computation") {
   CHECK((P - P.transpose()).norm() == 0.0);
 }
 
-TEST_CASE("a CV mode borrows the receiving mode's acceleration when mixed") {
+TEST_CASE("a CV mode borrows the receiving acceleration") {
   // CV: 6 states [x vx y vy z vz]; x = 10, vx = 1, P = I.
   Eigen::Matrix<double, 6, 1> xcv = Eigen::Matrix<double, 6, 1>::Zero();
   xcv(0) = 10.0;
@@ -122,7 +122,7 @@ TEST_CASE("mode probabilities in the log domain sum to 1") {
   CHECK(mu[1] == 0.25);
 }
 
-TEST_CASE("Gaussian log likelihood and the quadratic form of an innovation") {
+TEST_CASE("log likelihood and NIS of an innovation") {
   CHECK(log_likelihood(3, 2.0, 36.0) == Approx(-0.5 * (2.0 + std::log(36.0) + 3.0 * std::log(2.0 * std::numbers::pi))));
   CHECK(log_likelihood(3, 2.0, 0.0) == -std::numeric_limits<double>::infinity());
   Eigen::Matrix3d S = Eigen::Vector3d(4.0, 9.0, 1.0).asDiagonal();
