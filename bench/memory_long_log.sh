@@ -60,7 +60,7 @@ measure() {  # measure LABEL COMMAND...: median max RSS of REPEATS runs, all val
     "$(printf '%s\n' "${values[@]}" | sort -n | awk '{ v[NR] = $1 } END { print v[int((NR + 1) / 2)] }')" \
     "$(printf '%s\n' "${values[@]}" | sort -n | tr '\n' ' ')"
   printf '    %s\n' "${times[@]}"
-  grep -E "^ *(radar|kf|score)\.(rows|skipped_rows|steps|updates|anis) " "$OUT/stdout" | sed 's/^/    /' || true
+  grep -E "^ +(measurements processed:|rows|skipped_rows|updates|estimates|anis) " "$OUT/stdout" | sed 's/^ */    /' | paste -sd ';' || true
 }
 
 make_log "$ROWS" "$LOGS/long.csv"
