@@ -143,7 +143,7 @@ TEST_CASE("the mean of the ANEES series is the summary's anees") {
 
 // Runs that reach time steps no earlier run had -- between known steps, after them, and out of
 // time order within a run -- still give one row per step in time order, each with its own sums.
-TEST_CASE("steps first reached by later runs keep time order and sums") {
+TEST_CASE("steps new in later runs keep time order and sums") {
   auto worker = test::make("sink.metrics", "{}", "score");
   auto aggregate = test::make("sink.metrics", "{}", "score");
   worker->set_inputs({kFilter, kTruth});
