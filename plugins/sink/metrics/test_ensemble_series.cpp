@@ -5,6 +5,8 @@
 
 #include <cmath>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "plugin_fixture.hpp"
 
@@ -137,4 +139,57 @@ TEST_CASE("the mean of the ANEES series is the summary's anees") {
   CHECK(sum / n == Approx(a->value).epsilon(1e-12));
   // The uninitialised estimates do not count as scored estimates.
   CHECK(s.find("estimates")->value == 4);
+}
+
+// Runs that reach time steps no earlier run had -- between known steps, after them, and out of
+// time order within a run -- still give one row per step in time order, each with its own sums.
+TEST_CASE("steps new in later runs keep time order and sums") {
+  auto worker = test::make("sink.metrics", "{}", "score");
+  auto aggregate = test::make("sink.metrics", "{}", "score");
+  worker->set_inputs({kFilter, kTruth});
+  aggregate->set_inputs({kFilter, kTruth});
+  // Estimate times and x errors per run (run 1 out of order: 3 before 1).
+  const std::vector<std::vector<std::pair<double, double>>> runs = {
+      {{0.0, 1.0}, {2.0, 1.0}, {4.0, 1.0}},
+      {{3.0, 2.0}, {1.0, 3.0}, {4.0, 2.0}},
+      {{0.0, 4.0}, {2.5, 5.0}, {5.0, 6.0}},
+  };
+  Diagnostics diag;
+  for (size_t r = 0; r < runs.size(); ++r) {
+    worker->start_run({r, 1, &diag});
+    for (int k = 0; k <= 10; ++k) {
+      Truth t;
+      t.time = 0.5 * k;
+      t.position = Vec3(10.0 * k, 0, 0);
+      worker->on_truth(t, 1);
+    }
+    for (const auto& [time, error] : runs[r]) {
+      Estimate e;
+      e.time = time;
+      e.initialised = true;
+      e.enu = Vec6::Zero();
+      e.enu(0) = 20.0 * time + error;  // truth x = 20 m/s * t
+      e.enu_covariance = Mat6::Identity();
+      worker->on_estimate(e, 0);
+    }
+    auto res = worker->end_run();
+    REQUIRE(res);
+    aggregate->merge(*res);
+  }
+  Summary s;
+  aggregate->finish(s, {"score", "", runs.size()});
+  REQUIRE(s.series.size() == 1);
+  const Series& e = s.series[0];
+  const double times[] = {0.0, 1.0, 2.0, 2.5, 3.0, 4.0, 5.0};
+  const double scored[] = {2, 1, 1, 1, 1, 2, 1};
+  const double rmse[] = {std::sqrt((1.0 + 16.0) / 2), 3.0, 1.0, 5.0, 2.0, std::sqrt((1.0 + 4.0) / 2), 6.0};
+  REQUIRE(e.rows() == 7);
+  for (size_t row = 0; row < 7; ++row) {
+    INFO("row " << row);
+    CHECK(cell(e, row, "time") == times[row]);
+    CHECK(cell(e, row, "runs_scored") == scored[row]);
+    CHECK(cell(e, row, "position_rmse") == Approx(rmse[row]));
+  }
+  CHECK(s.find("steps")->value == 7);
+  CHECK(s.find("estimates")->value == 9);
 }
