@@ -43,8 +43,10 @@ class ExtendedKalmanFilter final
   template <int M>
   bool correct(const Measurement& m) {
     using MatM = Eigen::Matrix<double, M, M>;
-    const Vec3 d = Layout::position(x_) - m.sensor_position;
-    const Vec3 v = Layout::velocity(x_);
+    // In the sensor's own axes (a tilted sensor: Measurement::sensor_axes); J is turned back into
+    // the frame's below.
+    const Vec3 d = frame_to_sensor(m, Layout::position(x_) - m.sensor_position);
+    const Vec3 v = frame_to_sensor(m, Layout::velocity(x_));
     SphericalJacobian<M> J;  // columns [x y z vx vy vz]
     SphericalVec<M> h;
     const SphericalSingularity sing = spherical_measurement_with_jacobian<M>(d, v, m.azimuth, h, J);
@@ -57,6 +59,17 @@ class ExtendedKalmanFilter final
     SphericalVec<M> nu = spherical_residual<M>(z, h);
     MatM R = R_.template topLeftCorner<M, M>();
     if (this->settings().zenith == cartesian_filter::Settings::Zenith::Curvature) condition_near_zenith<M>(m, d, sing, J, nu, R);
+    if (!m.sensor_level) {  // dh/dx_frame = dh/dd_sensor A' (position and velocity columns)
+      const Mat3 At = m.sensor_axes.transpose();
+      for (int k = 0; k < M; ++k) {
+        const Eigen::RowVector3d jp = J.template block<1, 3>(k, 0) * At;
+        J.template block<1, 3>(k, 0) = jp;
+        if (k == 3) {
+          const Eigen::RowVector3d jv = J.template block<1, 3>(k, 3) * At;
+          J.template block<1, 3>(k, 3) = jv;
+        }
+      }
+    }
     // Rows r, az, el depend on the position only; the range rate's also on the velocity.
     Eigen::Matrix<double, N, M> PHt;
     for (int k = 0; k < M; ++k)
@@ -93,6 +106,12 @@ class ExtendedKalmanFilter final
                              SphericalVec<M>& nu, Eigen::Matrix<double, M, M>& R) {
     Eigen::Matrix2d Ph;
     Ph << P_(idx_[0], idx_[0]), P_(idx_[0], idx_[1]), P_(idx_[1], idx_[0]), P_(idx_[1], idx_[1]);
+    if (!m.sensor_level) {  // the horizontal block in the sensor's own axes
+      Mat3 Pp;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) Pp(i, j) = P_(idx_[i], idx_[j]);
+      Ph = (m.sensor_axes.transpose() * Pp * m.sensor_axes).topLeftCorner<2, 2>();
+    }
     const ekf::AngleCurvature curvature = ekf::angle_curvature_variance(d, Ph, kZenithFraction * d.norm());
     const double raz = R(1, 1);
     R(2, 2) += curvature.elevation;
@@ -142,8 +161,12 @@ void register_components(Registrar& r) {
       "added to R and the azimuth is dropped while the zenith is within 3 sigma (zenith: curvature; zenith: textbook "
       "is the plain EKF); dropped and de-weighted azimuths are counted in the summary. Invalid measurements: predict "
       "only. "
-      "R from each measurement in spherical space (adapters may replace it; q per ENU axis). See docs/filters.md.";
+      "R from each measurement in spherical space (adapters may replace it; q per ENU axis)."
+      " Several inputs (up to 8 radars, each at its own site with its own noise, rate and biases): the measurements are used one after another in time order, equal time stamps in the engine's delivery order (the order of the radars' declaration when they share a truth source); a tilted sensor (a geodetic site away from the frame's origin) is measured in its own axes; the summary then gives updates.<input> and nis_mean.<input> (mean NIS per element with its 95 % chi-square band) per sensor. See docs/filters.md.";
   d.accepts = mask(ItemKind::Measurement);
+  // Several radars into one track: one input per sensor (docs/filters.md, "Several sensors").
+  d.min_inputs = 1;
+  d.max_inputs = FrontEndRunResult::kMaxPorts;
   d.produces = mask(ItemKind::Estimate);
   d.accepts_frames = mask(Frame::Spherical);
   d.params = cartesian_filter::param_specs();
