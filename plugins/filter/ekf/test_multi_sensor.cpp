@@ -71,7 +71,7 @@ void check_consistent(const Metric* m) {
 // Both stations described correctly: each one's mean NIS inside its 95 % band, and the updates
 // counted per station (600 + 300 per run, less the two-point initialisation's). Ignoring B's
 // tilt (0.6 deg = 10 mrad against 0.5 mrad of noise) would put its NIS in the hundreds.
-TEST_CASE("ekf: several radars - per-sensor NIS inside its band, tilted sensor in its own axes") {
+TEST_CASE("ekf: several radars - NIS per sensor in band and tilt") {
   for (const char* type : {"filter.ekf", "filter.ukf"}) {
     INFO(type);
     const Summary s = two_sensor_summary(type, 0.0);
@@ -85,7 +85,7 @@ TEST_CASE("ekf: several radars - per-sensor NIS inside its band, tilted sensor i
 
 // An elevation bias of 1.5 mrad (3 sigma) on station B that the filter does not know: B's mean
 // NIS leaves its band and stands above A's (A's rises too: the track is pulled towards B).
-TEST_CASE("ekf: several radars - an unmodelled station bias shows in that station's NIS") {
+TEST_CASE("ekf: several radars - unmodelled bias shows in its NIS") {
   const Summary s = two_sensor_summary("filter.ekf", 1.5e-3);
   const Metric* b = s.find("nis_mean.b");
   const Metric* a = s.find("nis_mean.a");

@@ -30,7 +30,7 @@ double scanned_weight(const Mat2& P1, const Mat2& P2, fusion::CiCriterion c) {
 
 // Mirror-image covariances: w = 1/2 by symmetry for either criterion, and the fused values by
 // hand: P = (0.5 diag(1, 1/4) + 0.5 diag(1/4, 1))^-1 = 1.6 I, x = P (0.5 P2^-1 x2) = (0.2, 0.8).
-TEST_CASE("track_fusion: CI of mirror-image covariances weighs them equally") {
+TEST_CASE("track_fusion: CI of mirror-image covariances") {
   const Mat2 P1 = Eigen::Vector2d(1, 4).asDiagonal(), P2 = Eigen::Vector2d(4, 1).asDiagonal();
   for (const auto c : {fusion::CiCriterion::Trace, fusion::CiCriterion::Determinant}) {
     fusion::CiResult<2> r;
@@ -44,7 +44,7 @@ TEST_CASE("track_fusion: CI of mirror-image covariances weighs them equally") {
 
 // Correlated, unequal covariances: the weight is the minimiser a direct scan of tr P (det P)
 // finds, and the two criteria give different weights.
-TEST_CASE("track_fusion: CI weight minimises the trace or the determinant") {
+TEST_CASE("track_fusion: CI weight minimises trace or det") {
   Mat2 P1, P2;
   P1 << 2.0, 0.5, 0.5, 1.0;
   P2 << 1.0, -0.3, -0.3, 3.0;
@@ -64,7 +64,7 @@ TEST_CASE("track_fusion: CI weight minimises the trace or the determinant") {
 }
 
 // One estimate far better in every direction: the optimum is the end w = 1, P = P1.
-TEST_CASE("track_fusion: CI keeps a dominating estimate alone") {
+TEST_CASE("track_fusion: CI keeps a dominating estimate") {
   const Mat2 P1 = 0.01 * Mat2::Identity(), P2 = Mat2::Identity();
   fusion::CiResult<2> r;
   REQUIRE(fusion::covariance_intersection<2>(Vec2(1, 1), P1, Vec2(5, 5), P2, fusion::CiCriterion::Trace, r));
@@ -78,7 +78,7 @@ TEST_CASE("track_fusion: CI keeps a dominating estimate alone") {
 // centralised update: Y = 1/4 + 1 + 1/4 = 1.5, y = 1 + 3/4 = 1.75, x = 7/6, P = 2/3. Information
 // matrix fusion reaches it exactly; adding the two posteriors naively (the prior twice) would
 // give Y = 1.75.
-TEST_CASE("track_fusion: information fusion equals the centralised update") {
+TEST_CASE("track_fusion: IMF equals the centralised update") {
   using V1 = Eigen::Matrix<double, 1, 1>;
   const V1 x0 = V1::Zero(), P0 = V1::Constant(4.0);
   V1 xf = x0, Pf = P0;
@@ -97,7 +97,7 @@ TEST_CASE("track_fusion: information fusion equals the centralised update") {
 
 // A 2-state case with cross-covariances, against the centralised filter computed directly:
 // prior x0, P0; sensor 1 sees the first component, sensor 2 the sum.
-TEST_CASE("track_fusion: information fusion with correlated states matches the centralised filter") {
+TEST_CASE("track_fusion: IMF of a correlated 2-state case") {
   Mat2 P0;
   P0 << 3.0, 1.0, 1.0, 2.0;
   const Vec2 x0(0.5, -1.0);

@@ -35,7 +35,7 @@ std::shared_ptr<Component> node(const std::string& yaml, test::Collector& out) {
 
 // Both local tracks start at t = 0 (no local prior): the fused information is the sum,
 // x = (1/1 * 0 + 1/4 * 10) / (1 + 1/4) = 2, P = 0.8. The first estimate alone is published first.
-TEST_CASE("track_fusion: information fusion of two first estimates adds their information") {
+TEST_CASE("track_fusion: node IMF adds first estimates") {
   test::Collector out;
   auto n = node("{method: information, q: 0 m2/s3}", out);
   n->on_estimate(cv_estimate(0.0, 0.0, 1.0), 0);
@@ -60,7 +60,7 @@ TEST_CASE("track_fusion: information fusion of two first estimates adds their in
 // CI of the same two estimates with the trace criterion: all axes alike, w = 0.5 or an end; the
 // fused variance is never below the better input's times the weight and the position lies
 // between the inputs.
-TEST_CASE("track_fusion: covariance intersection publishes a fused estimate between the inputs") {
+TEST_CASE("track_fusion: node CI lies between its inputs") {
   test::Collector out;
   auto n = node("{q: 0 m2/s3}", out);
   n->on_estimate(cv_estimate(0.0, 0.0, 1.0), 0);
@@ -73,7 +73,7 @@ TEST_CASE("track_fusion: covariance intersection publishes a fused estimate betw
   CHECK(f.enu_covariance(0, 0) <= 1.0 + 1e-12);
 }
 
-TEST_CASE("track_fusion: a local state of another size is refused") {
+TEST_CASE("track_fusion: node refuses another state size") {
   test::Collector out;
   auto n = node("{motion: constant_acceleration}", out);
   CHECK_THROWS_AS(n->on_estimate(cv_estimate(0.0, 0.0, 1.0), 0), DataError);

@@ -213,7 +213,7 @@ Mat3 enu_rows(double lat, double lon) {
 // A radar at a site 1.5 deg of arc from the frame's origin measures from its own horizon: a target
 // straight above it (along its ellipsoid normal) is at 90 deg elevation, one due east of it
 // along its own east at 0 deg and azimuth 90 deg, though both are tilted in the frame's axes.
-TEST_CASE("sim.radar at a site away from the frame's origin measures from its own horizon") {
+TEST_CASE("sim.radar at a distant site measures from its own horizon") {
   const std::string sites =
       "sites: [{name: naro, latitude: 34.43 deg, longitude: 127.53 deg},"
       " {name: jeju, latitude: 33.28 deg, longitude: 126.46 deg, height: 100 m}]\nframe_origin: jeju\n";

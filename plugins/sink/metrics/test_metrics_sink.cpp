@@ -350,7 +350,7 @@ TEST_CASE("bad inputs or confidence are config errors") {
 // off, the second (after both updates) exact. same_time: all scores both (RMSE sqrt(100 / 2)
 // over the two at t = 1 plus the exact one at t = 0: sqrt(100 / 3)); same_time: last only the
 // second (RMSE 0, one estimate per time).
-TEST_CASE("metrics: same_time last scores only the last estimate of a time stamp") {
+TEST_CASE("metrics: same_time last scores the last estimate only") {
   auto feed = [](Component& c, int) {
     c.on_truth(truth(0, Vec3::Zero()), 1);
     c.on_truth(truth(1, Vec3::Zero()), 1);
