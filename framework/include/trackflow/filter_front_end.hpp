@@ -1,9 +1,11 @@
 // Purpose: the one measurement front end every filter uses — validity, frame, well-formedness, time order, range rate, R, adapter hooks, non-finite checks (measurement in, state out), initialise/predict/update/publish — with its counted skips.
 #pragma once
 
+#include <trackflow/chi_square.hpp>
 #include <trackflow/component.hpp>
 #include <trackflow/error.hpp>
 #include <trackflow/common_params.hpp>
+#include <trackflow/geometry.hpp>
 #include <trackflow/run_result_codec.hpp>
 
 #include <Eigen/Core>
@@ -27,6 +29,9 @@ struct FrontEndSpec {
   RangeRateUse range_rate = RangeRateUse::Ignore;
   // Filter-specific events counted per run and reported in the summary (see count()).
   std::vector<std::string> counters;
+  // Whether the filter's measurement function turns into the sensor's own axes
+  // (Measurement::sensor_axes); otherwise a tilted sensor's measurement is refused.
+  bool tilted_sensors = false;
 };
 
 // Counts of one run, summed in run order into the node's summary.
@@ -38,6 +43,12 @@ struct FrontEndRunResult final : RunResult {
   std::uint64_t rejected = 0;    // the filter refused the update (it said why in a warning)
   std::uint64_t counters[kMaxCounters] = {};
   std::uint64_t refused_non_finite = 0;  // steps whose state came out non-finite: not published, track restarted
+  // Per input port (one sensor's stream each when a filter takes several): updates, the sum of
+  // their NIS and of their dimensions (the NIS sum's degrees of freedom).
+  static constexpr int kMaxPorts = 8;
+  std::uint64_t port_updates[kMaxPorts] = {};
+  double port_nis[kMaxPorts] = {};
+  std::uint64_t port_dof[kMaxPorts] = {};
 };
 
 // The template method of every filter (CRTP: no virtual call on the hot path). Derived provides
@@ -68,7 +79,15 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
     initialised_ = derived().reset_track();
   }
 
-  void on_measurement(const Measurement& m, int) final {
+  // Several inputs (one per sensor) are merged by the engine in time order; equal time stamps
+  // arrive in the engine's delivery order (docs/architecture.md) and are used one after the other
+  // with no prediction between them. The input names label the per-sensor statistics.
+  void set_inputs(const std::vector<InputInfo>& inputs) override {
+    inputs_.clear();
+    for (const InputInfo& in : inputs) inputs_.push_back(in.node);
+  }
+
+  void on_measurement(const Measurement& m, int port) final {
     const int n = static_cast<int>(m.value.size());
     const bool well_formed =
         m.frame == spec_.frame && n == (m.has_range_rate ? 4 : 3) && m.covariance.rows() == n && m.covariance.cols() == n;
@@ -121,6 +140,12 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
     if (usable) used = dim == 4 ? derived().template update<4>(m) : derived().template update<3>(m);
     if (!publish_state(m)) return;
     if (usable) ++(used ? run_.updates : run_.rejected);
+    if (used) {
+      const int p = port >= 0 && port < FrontEndRunResult::kMaxPorts ? port : FrontEndRunResult::kMaxPorts - 1;
+      ++run_.port_updates[p];
+      run_.port_nis[p] += est_.nis;
+      run_.port_dof[p] += static_cast<std::uint64_t>(dim);
+    }
   }
 
   std::unique_ptr<RunResult> end_run() final {
@@ -137,6 +162,9 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
     out.put(r.rejected);
     out.put(r.counters);
     out.put(r.refused_non_finite);
+    out.put(r.port_updates);
+    out.put(r.port_nis);
+    out.put(r.port_dof);
   }
   std::unique_ptr<RunResult> load_run_result(ByteReader& in) const final {
     auto r = std::make_unique<FrontEndRunResult>();
@@ -146,6 +174,9 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
     in.get(r->rejected);
     in.get(r->counters);
     in.get(r->refused_non_finite);
+    in.get(r->port_updates);
+    in.get(r->port_nis);
+    in.get(r->port_dof);
     return r;
   }
 
@@ -157,6 +188,11 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
     total_.rejected += r.rejected;
     total_.refused_non_finite += r.refused_non_finite;
     for (int i = 0; i < FrontEndRunResult::kMaxCounters; ++i) total_.counters[i] += r.counters[i];
+    for (int i = 0; i < FrontEndRunResult::kMaxPorts; ++i) {
+      total_.port_updates[i] += r.port_updates[i];
+      total_.port_nis[i] += r.port_nis[i];
+      total_.port_dof[i] += r.port_dof[i];
+    }
   }
 
   void finish(Summary& s, const FinishContext&) override {
@@ -167,7 +203,11 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
     if (total_.refused_non_finite) s.metric("non_finite_state_refused", static_cast<double>(total_.refused_non_finite));
     for (size_t i = 0; i < spec_.counters.size() && i < FrontEndRunResult::kMaxCounters; ++i)
       s.metric(spec_.counters[i], static_cast<double>(total_.counters[i]));
+    if (inputs_.size() > 1) per_sensor_summary(s);
   }
+
+  // Confidence of the per-sensor NIS bands in the summary.
+  static constexpr double kNisConfidence = 0.95;
 
   bool initialised() const { return initialised_; }
 
@@ -234,6 +274,19 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
  private:
   Derived& derived() { return static_cast<Derived&>(*this); }
 
+  // With several inputs: each sensor's updates and mean NIS per measurement element (1 for a
+  // consistent filter and a well-calibrated sensor), with its chi-square band over all of that
+  // sensor's updates: a station whose bias or noise the filter does not know stands out.
+  void per_sensor_summary(Summary& s) const {
+    for (size_t i = 0; i < inputs_.size() && i < static_cast<size_t>(FrontEndRunResult::kMaxPorts); ++i) {
+      s.metric("updates." + inputs_[i], static_cast<double>(total_.port_updates[i]));
+      if (total_.port_dof[i] == 0) continue;
+      const double dof = static_cast<double>(total_.port_dof[i]);
+      const ChiSquareBand band = chi_square_mean_band(dof, kNisConfidence);
+      s.metric_band("nis_mean." + inputs_[i], total_.port_nis[i] / dof, band.lo, band.hi, kNisConfidence);
+    }
+  }
+
   void check_valid(const Measurement& m, int n, bool well_formed) {
     if (m.frame != spec_.frame)
       throw DataError(who() + " takes " + to_string(spec_.frame) + " measurements, but the one at t=" +
@@ -249,6 +302,7 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
     if (spec_.range_rate == RangeRateUse::Use && !m.has_range_rate)
       throw DataError(who() + ": range_rate: use, but the measurement at t=" + std::to_string(m.time) +
                       " s has no range rate (range_rate: auto accepts both)");
+    if (!m.sensor_level && !spec_.tilted_sensors) throw DataError(who() + ": " + tilted_sensor_message(m));
     derived().check_measurement(m);
   }
 
@@ -327,6 +381,7 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
   double time_ = 0.0;
   bool has_time_ = false, initialised_ = false, non_finite_reported_ = false, refusal_reported_ = false;
   FrontEndRunResult run_, total_;
+  std::vector<std::string> inputs_;  // upstream node of each input port
   mutable Estimate scratch_;  // read_covariance's, so the published estimate is never touched
 };
 

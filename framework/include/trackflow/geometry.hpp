@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <numbers>
+#include <string>
 
 namespace trackflow {
 
@@ -61,6 +62,27 @@ inline Vec3 enu_to_spherical(const Vec3& d, AzimuthConvention c) {
 inline double range_rate(const Vec3& d, const Vec3& v) {
   const double r = d.norm();
   return r > 0.0 ? d.dot(v) / r : v.norm();
+}
+
+// A vector in the sensor's own axes (Measurement::sensor_axes) -> the frame's axes, and back.
+inline Vec3 sensor_to_frame(const Measurement& m, const Vec3& v) { return m.sensor_level ? v : Vec3(m.sensor_axes * v); }
+inline Vec3 frame_to_sensor(const Measurement& m, const Vec3& v) {
+  return m.sensor_level ? v : Vec3(m.sensor_axes.transpose() * v);
+}
+
+// A spherical measurement's position in the frame: sensor position plus the converted offset,
+// turned into the frame's axes when the sensor is tilted.
+inline Vec3 measured_position(const Measurement& m) {
+  return sensor_to_frame(m, spherical_to_enu(m.value(0), m.value(1), m.value(2), m.azimuth)) + m.sensor_position;
+}
+
+// The text of the error a consumer that works in the frame's axes gives for a tilted sensor
+// (empty: the sensor is level). Callers throw it as a DataError with their node's name.
+inline std::string tilted_sensor_message(const Measurement& m) {
+  if (m.sensor_level) return {};
+  return "the measurement at t=" + std::to_string(m.time) + " s comes from sensor " + std::to_string(m.sensor) +
+         ", whose horizon is tilted against the frame (a geodetic site away from pipeline.frame_origin); this node "
+         "works in the frame's axes only: use filter.ekf or filter.ukf, or anchor the frame at that sensor";
 }
 
 }  // namespace trackflow

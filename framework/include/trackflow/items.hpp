@@ -64,6 +64,14 @@ struct Measurement {
   bool has_snr = false;
   double snr_db = 0.0;
   Vec3 sensor_position = Vec3::Zero();  // sensor location in the ENU frame
+  // The sensor's own east, north and up axes (columns, in the frame's axes): its azimuth and
+  // elevation are measured from its own horizon, d_sensor = sensor_axes' d_frame. A radar at a
+  // geodetic site away from the frame's origin is tilted against the frame (1 deg of arc per
+  // ~111 km); sensor_level marks the identity, so consumers skip the rotation and level sensors
+  // give bit-for-bit the results they always did. Consumers that do not rotate refuse a tilted
+  // sensor (require_level_sensor, geometry.hpp).
+  Mat3 sensor_axes = Mat3::Identity();
+  bool sensor_level = true;
   MeasVec value;
   MeasCov covariance;
 

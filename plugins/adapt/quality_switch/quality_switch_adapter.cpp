@@ -126,7 +126,7 @@ class QualitySwitchAdapter final : public Adapter, public RunResultCodec {
   // burst may put the target anywhere.
   void after_update(const Measurement& m, const Estimate& e, Filter&) override {
     if (!e.initialised) return;
-    const Vec3 d = e.enu.head<3>() - m.sensor_position;
+    const Vec3 d = frame_to_sensor(m, e.enu.head<3>() - m.sensor_position);  // the sensor's own axes
     if (!d.allFinite() || d.norm() <= 0.0) return;
     set_geometry(enu_to_spherical(d, m.azimuth), m.azimuth);
   }

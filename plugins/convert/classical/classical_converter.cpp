@@ -1,4 +1,5 @@
 // Purpose: convert.classical — spherical to Cartesian measurement, covariance by the exact Jacobian.
+#include <trackflow/error.hpp>
 #include <trackflow/geometry.hpp>
 #include <trackflow/plugin.hpp>
 
@@ -18,6 +19,7 @@ class ClassicalConverter final : public Component {
       out.emit(in);  // already Cartesian, or nothing to convert: pass on unchanged
       return;
     }
+    if (!in.sensor_level) throw DataError("convert.classical: " + tilted_sensor_message(in));
     const double r = in.value(0), az = in.value(1), el = in.value(2);
     const int n = static_cast<int>(in.value.size());
     if ((n != 3 && n != 4) || in.covariance.rows() != n || in.covariance.cols() != n) {

@@ -47,6 +47,7 @@ class StatisticalConverter final : public Component {
       out.emit(in);  // already Cartesian, or nothing to convert: pass on unchanged
       return;
     }
+    if (!in.sensor_level) throw DataError(type_ + " (node '" + node_ + "'): " + tilted_sensor_message(in));
     check(in);
     note_correlation(in);
     const int n = static_cast<int>(in.value.size());

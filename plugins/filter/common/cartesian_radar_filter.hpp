@@ -63,7 +63,7 @@ class CartesianRadarFilter : public FilterFrontEnd<CartesianRadarFilter<Order, D
 
  protected:
   explicit CartesianRadarFilter(Settings s)
-      : FrontEnd(FrontEndSpec{s.type, s.node, Frame::Spherical, s.range_rate, derived_counters()}), State(s) {
+      : FrontEnd(FrontEndSpec{s.type, s.node, Frame::Spherical, s.range_rate, derived_counters(), true}), State(s) {
     this->est_.state.resize(N);
     this->est_.covariance.resize(N, N);
   }

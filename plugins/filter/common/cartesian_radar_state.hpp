@@ -144,9 +144,11 @@ class CartesianRadarState {
     if (points_ > 0 && m.time == tc_[points_ - 1]) --points_;  // same time stamp: keep the newer one
     // Classical conversion with the exact Jacobian covariance (as convert.classical).
     const double r = m.value(0), az = m.value(1), el = m.value(2);
-    const Mat3 J = spherical_to_enu_jacobian(r, az, el, m.azimuth);
+    // A tilted sensor's offset is in its own axes: turned into the frame's, with its Jacobian.
+    const Mat3 J = m.sensor_level ? spherical_to_enu_jacobian(r, az, el, m.azimuth)
+                                  : Mat3(m.sensor_axes * spherical_to_enu_jacobian(r, az, el, m.azimuth));
     const Mat3 Rs = R.topLeftCorner(3, 3);
-    zc_[points_] = spherical_to_enu(r, az, el, m.azimuth) + m.sensor_position;
+    zc_[points_] = sensor_to_frame(m, spherical_to_enu(r, az, el, m.azimuth)) + m.sensor_position;
     const Mat3 Rc = J * Rs * J.transpose();
     Rc_[points_] = 0.5 * (Rc + Rc.transpose());
     tc_[points_] = m.time;

@@ -34,11 +34,17 @@ struct EkfInnovation {
 // azimuth may flip by pi and is dropped: zero row, zero innovation, R decorrelated (an
 // infinitely uncertain azimuth; range, elevation and range rate still update).
 template <int N, int M>
-void condition_near_zenith(const Eigen::Matrix<double, N, N>& P, const int idx[6], const Vec3& d,
+void condition_near_zenith(const Eigen::Matrix<double, N, N>& P, const int idx[6], const Measurement& m, const Vec3& d,
                            SphericalSingularity sing, SphericalJacobian<M>& J, SphericalVec<M>& nu,
                            Eigen::Matrix<double, M, M>& R, EkfInnovation<M>& out) {
   Eigen::Matrix2d Ph;
   Ph << P(idx[0], idx[0]), P(idx[0], idx[1]), P(idx[1], idx[0]), P(idx[1], idx[1]);
+  if (!m.sensor_level) {  // the horizontal block in the sensor's own axes
+    Mat3 Pp;
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) Pp(i, j) = P(idx[i], idx[j]);
+    Ph = (m.sensor_axes.transpose() * Pp * m.sensor_axes).template topLeftCorner<2, 2>();
+  }
   const ekf::AngleCurvature curvature = ekf::angle_curvature_variance(d, Ph, kZenithFraction * d.norm());
   const double raz = R(1, 1);
   R(2, 2) += curvature.elevation;
@@ -66,8 +72,10 @@ EkfOutcome ekf_radar_update(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double
                             EkfInnovation<M>& out) {
   using MatM = Eigen::Matrix<double, M, M>;
   out.azimuth_dropped = out.azimuth_deweighted = false;
-  const Vec3 d = Vec3(x(idx[0]), x(idx[1]), x(idx[2])) - m.sensor_position;
-  const Vec3 v(x(idx[3]), x(idx[4]), x(idx[5]));
+  // In the sensor's own axes (a tilted sensor: Measurement::sensor_axes); J is turned back into
+  // the frame's below.
+  const Vec3 d = frame_to_sensor(m, Vec3(x(idx[0]), x(idx[1]), x(idx[2])) - m.sensor_position);
+  const Vec3 v = frame_to_sensor(m, Vec3(x(idx[3]), x(idx[4]), x(idx[5])));
   SphericalJacobian<M> J;  // columns [x y z vx vy vz]
   SphericalVec<M> h;
   const SphericalSingularity sing = spherical_measurement_with_jacobian<M>(d, v, m.azimuth, h, J);
@@ -75,7 +83,18 @@ EkfOutcome ekf_radar_update(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double
   const SphericalVec<M> z = m.value.template head<M>();
   SphericalVec<M> nu = spherical_residual<M>(z, h);
   MatM R = R_measured;
-  if (curvature) condition_near_zenith<N, M>(P, idx, d, sing, J, nu, R, out);
+  if (curvature) condition_near_zenith<N, M>(P, idx, m, d, sing, J, nu, R, out);
+  if (!m.sensor_level) {  // dh/dx_frame = dh/dd_sensor A' (position and velocity columns)
+    const Mat3 At = m.sensor_axes.transpose();
+    for (int k = 0; k < M; ++k) {
+      const Eigen::RowVector3d jp = J.template block<1, 3>(k, 0) * At;
+      J.template block<1, 3>(k, 0) = jp;
+      if (k == 3) {
+        const Eigen::RowVector3d jv = J.template block<1, 3>(k, 3) * At;
+        J.template block<1, 3>(k, 3) = jv;
+      }
+    }
+  }
   // Rows r, az, el depend on the position only; the range rate's also on the velocity.
   Eigen::Matrix<double, N, M> PHt;
   for (int k = 0; k < M; ++k)

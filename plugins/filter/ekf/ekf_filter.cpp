@@ -91,8 +91,12 @@ void register_components(Registrar& r) {
       "added to R and the azimuth is dropped while the zenith is within 3 sigma (zenith: curvature; zenith: textbook "
       "is the plain EKF); dropped and de-weighted azimuths are counted in the summary. Invalid measurements: predict "
       "only. "
-      "R from each measurement in spherical space (adapters may replace it; q per ENU axis). See docs/filters.md.";
+      "R from each measurement in spherical space (adapters may replace it; q per ENU axis)."
+      " Several inputs (up to 8 radars, each at its own site with its own noise, rate and biases): the measurements are used one after another in time order, equal time stamps in the engine's delivery order (the order of the radars' declaration when they share a truth source); a tilted sensor (a geodetic site away from the frame's origin) is measured in its own axes; the summary then gives updates.<input> and nis_mean.<input> (mean NIS per element with its 95 % chi-square band) per sensor. See docs/filters.md.";
   d.accepts = mask(ItemKind::Measurement);
+  // Several radars into one track: one input per sensor (docs/filters.md, "Several sensors").
+  d.min_inputs = 1;
+  d.max_inputs = FrontEndRunResult::kMaxPorts;
   d.produces = mask(ItemKind::Estimate);
   d.accepts_frames = mask(Frame::Spherical);
   d.params = cartesian_filter::param_specs();

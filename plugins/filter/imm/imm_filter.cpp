@@ -64,7 +64,7 @@ class ImmFilter final : public FilterFrontEnd<ImmFilter> {
  public:
   explicit ImmFilter(const ImmConfig& c)
       : FilterFrontEnd(FrontEndSpec{"filter.imm", c.node, Frame::Spherical, c.range_rate,
-                                    {"azimuth_dropped", "mode_updates_refused"}}),
+                                    {"azimuth_dropped", "mode_updates_refused"}, true}),
         count_(static_cast<int>(c.modes.size())) {
     for (int j = 0; j < count_; ++j) {
       modes_[j] = c.modes[static_cast<size_t>(j)];

@@ -84,7 +84,9 @@ class UnscentedKalmanFilter final
     // The sigma points x ± c L_j measured as offsets from the centre (sigma_spherical.hpp). h
     // reads the position (and, with the range rate, the velocity): a column of L that moves
     // neither gives h(x) itself (the last one, which moves only the last acceleration).
-    const ukf::SphericalNearCentre<M> near(Layout::position(x_) - m.sensor_position, Layout::velocity(x_), m.azimuth);
+    // A tilted sensor (Measurement::sensor_axes) sees the centre and the offsets in its own axes.
+    const ukf::SphericalNearCentre<M> near(frame_to_sensor(m, Layout::position(x_) - m.sensor_position),
+                                           frame_to_sensor(m, Layout::velocity(x_)), m.azimuth);
     constexpr int kRead = M == 4 ? 6 : 3;
     const double c = weights_.spread;
     typename ukf::SphericalNearCentre<M>::template Batch<2 * N> points;
@@ -103,6 +105,15 @@ class UnscentedKalmanFilter final
       points.fx[k + 1] = -(points.fx[k] = c * L(idx_[3], j));
       points.fy[k + 1] = -(points.fy[k] = c * L(idx_[4], j));
       points.fz[k + 1] = -(points.fz[k] = c * L(idx_[5], j));
+    }
+    if (!m.sensor_level) {
+      const Mat3 At = m.sensor_axes.transpose();
+      for (int k = 0; k < points.count; ++k) {
+        const Vec3 e = At * Vec3(points.ex[k], points.ey[k], points.ez[k]);
+        const Vec3 f = At * Vec3(points.fx[k], points.fy[k], points.fz[k]);
+        points.ex[k] = e.x(), points.ey[k] = e.y(), points.ez[k] = e.z();
+        points.fx[k] = f.x(), points.fy[k] = f.y(), points.fz[k] = f.z();
+      }
     }
     near.evaluate(points);
     const SphericalVec<M>* zp[N];
@@ -184,8 +195,12 @@ void register_components(Registrar& r) {
       "(no +-pi cut) and every residual's azimuth is wrapped to (-pi, pi]. Update in Joseph form with the "
       "statistically linearised H = P_zx P^-1 and R plus the unexplained spread (equal to P - K S K', kept "
       "positive semi-definite). Defaults alpha 1, beta 2, kappa 3 - n: sigma points at sqrt(3) sigma (the Gaussian's "
-      "fourth moment, Julier & Uhlmann 2004) and non-negative covariance weights for n <= 9. See docs/filters.md.";
+      "fourth moment, Julier & Uhlmann 2004) and non-negative covariance weights for n <= 9."
+      " Several inputs (up to 8 radars, each at its own site with its own noise, rate and biases): the measurements are used one after another in time order, equal time stamps in the engine's delivery order (the order of the radars' declaration when they share a truth source); a tilted sensor (a geodetic site away from the frame's origin) is measured in its own axes; the summary then gives updates.<input> and nis_mean.<input> (mean NIS per element with its 95 % chi-square band) per sensor. See docs/filters.md.";
   d.accepts = mask(ItemKind::Measurement);
+  // Several radars into one track: one input per sensor (docs/filters.md, "Several sensors").
+  d.min_inputs = 1;
+  d.max_inputs = FrontEndRunResult::kMaxPorts;
   d.produces = mask(ItemKind::Estimate);
   d.accepts_frames = mask(Frame::Spherical);
   d.params = cartesian_filter::param_specs();

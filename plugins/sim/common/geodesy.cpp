@@ -94,4 +94,14 @@ Vec3 EnuFrame::up_at(const GeodeticPoint& g) const {
   return ecef_to_enu_ * Vec3(cl * std::cos(g.longitude), cl * std::sin(g.longitude), std::sin(g.latitude));
 }
 
+Mat3 EnuFrame::axes_at(const GeodeticPoint& g) const {
+  const double sl = std::sin(g.latitude), cl = std::cos(g.latitude);
+  const double so = std::sin(g.longitude), co = std::cos(g.longitude);
+  Mat3 local;  // columns: east, north, up at g, in ECEF
+  local.col(0) = Vec3(-so, co, 0.0);
+  local.col(1) = Vec3(-sl * co, -sl * so, cl);
+  local.col(2) = Vec3(cl * co, cl * so, sl);
+  return ecef_to_enu_ * local;
+}
+
 }  // namespace trackflow::sim

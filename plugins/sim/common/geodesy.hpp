@@ -51,6 +51,9 @@ class EnuFrame {
   Vec3 ecef_to_enu(const Vec3& ecef) const;
   // Unit vector of the local vertical (ellipsoid normal) at g, in this frame's axes.
   Vec3 up_at(const GeodeticPoint& g) const;
+  // The local east, north and up unit vectors at g (columns), in this frame's axes: a sensor
+  // there measures its angles in them (Measurement::sensor_axes).
+  Mat3 axes_at(const GeodeticPoint& g) const;
   const GeodeticPoint& origin() const { return origin_; }
   const GeographicLib::LocalCartesian& local() const { return local_; }
 

@@ -23,13 +23,17 @@ using sim::NoiseSigmas;
 
 enum class ReportedNoise { Actual, Nominal };
 
-// A radar at a geodetic site measures in the pipeline's ENU axes, so its local vertical must be
-// the frame's: within this angle (about 1 km from the frame's origin).
+// A radar at a geodetic site measures its angles from its own horizon. Within this angle of arc
+// of the frame's origin (about 1 km) its axes are taken as the frame's (a level sensor, as
+// before sites away from the origin were possible); beyond it, its measurements carry its own
+// east/north/up axes (Measurement::sensor_axes).
 constexpr double kMaxSiteTilt = 0.01 * std::numbers::pi / 180.0;  // rad
 
 struct RadarPlace {
   Vec3 position = Vec3::Zero();
   double height = 0.0;  // above the ellipsoid (site) or the frame's origin (position z)
+  bool level = true;
+  Mat3 axes = Mat3::Identity();  // the radar's east, north, up in the frame's axes (when not level)
 };
 
 // `position` in the frame, or `site` among the pipeline's geodetic sites.
@@ -43,12 +47,12 @@ RadarPlace radar_place(const Params& p) {
   const sim::Site site = sim::find_site(p, sites, "site");
   const sim::EnuFrame frame = sim::EnuFrame::from_params(p, sites, "site");
   const double tilt = std::acos(std::clamp(frame.up_at(site.where).z(), -1.0, 1.0));
-  if (tilt > kMaxSiteTilt)
-    throw p.error("site", "'" + site.name + "' is " + std::to_string(tilt * sim::kRadToDeg) +
-                              " deg of arc from the frame's origin: sim.radar measures azimuth and elevation in the "
-                              "pipeline's ENU axes, which are not its local horizon there. Anchor the frame at this "
-                              "radar (pipeline: { frame_origin: " + site.name + " })");
-  return {frame.to_enu(site.where), site.where.height};
+  RadarPlace place{frame.to_enu(site.where), site.where.height};
+  if (tilt > kMaxSiteTilt) {
+    place.level = false;
+    place.axes = frame.axes_at(site.where);
+  }
+  return place;
 }
 
 // Per-run count of measurements the refraction model left undefined (flagged invalid).
@@ -104,6 +108,8 @@ class RadarSource final : public Component, public RunResultCodec {
     m_.azimuth = convention_;
     m_.has_range_rate = with_range_rate;
     m_.sensor_position = sensor_position_;
+    m_.sensor_level = place_.level;
+    m_.sensor_axes = place_.axes;
     m_.value = MeasVec::Zero(n);
     m_.covariance = MeasCov::Zero(n, n);
   }
@@ -125,7 +131,8 @@ class RadarSource final : public Component, public RunResultCodec {
     }
     // Relative geometry. At the sensor or the zenith the azimuth is undefined and
     // enu_to_spherical returns 0 for it (atan2(0, 0)); range_rate returns |v| at zero range.
-    const Vec3 d = t.position - sensor_position_;
+    // In the radar's own axes (its horizon) when its site is tilted against the frame.
+    const Vec3 d = place_.level ? Vec3(t.position - sensor_position_) : Vec3(place_.axes.transpose() * (t.position - sensor_position_));
     const Vec3 rae = enu_to_spherical(d, convention_);
     const sim::TimeWindow* window = modes_.find(t.time);
     const NoiseSigmas nominal = sigmas_for(rae, window);
@@ -145,7 +152,8 @@ class RadarSource final : public Component, public RunResultCodec {
         ++refraction_invalid_;
       }
     }
-    if (m_.has_range_rate) m_.value(3) = range_rate(d, t.velocity);
+    if (m_.has_range_rate)
+      m_.value(3) = range_rate(d, place_.level ? t.velocity : Vec3(place_.axes.transpose() * t.velocity));
     add_noise(nominal.scaled(shot_.factor(emitted_)));
     m_.value(1) = wrap_angle(m_.value(1));
     // reported_noise: nominal — a degraded radar that does not know it is degraded reports
@@ -290,10 +298,12 @@ const char* const kDoc =
     "exp(-h/scale_height) over a sphere of earth_radius, from the radar's height (its site's, else position z) to the "
     "target; flagged invalid where no ray reaches it. Range delay is not modelled. The summary counts the "
     "measurements flagged invalid by the model (refraction_invalid). b is measured from the radar's horizon: "
-    "with site, the frame must be anchored at the radar (pipeline.frame_origin).\n"
+    "with site, from the radar's own horizon.\n"
     "Geodetic placement: site names one of the pipeline's sites: (WGS-84 latitude, longitude, height), placed in the "
-    "ENU frame anchored at pipeline.frame_origin; azimuth and elevation are measured in the frame's axes, so the "
-    "site must be the frame's origin (within 0.01 deg of arc).";
+    "ENU frame anchored at pipeline.frame_origin; azimuth and elevation are measured from the site's own horizon "
+    "(its east, north, up). Within 0.01 deg of arc of the origin these are taken as the frame's axes; farther away "
+    "(1 deg of arc per ~111 km) each measurement carries the radar's axes (a tilted sensor), which filter.ekf, "
+    "filter.ukf and the sinks that place measurements in the frame use, and other consumers refuse.";
 
 void register_components(Registrar& r) {
   ComponentDecl d;
@@ -305,8 +315,8 @@ void register_components(Registrar& r) {
   d.params = {
       ParamSpec::real_list("position", dim::length, "radar position in the ENU frame [x east, y north, z up]", 3)
           .def("[0, 0, 0]"),
-      ParamSpec::string("site", "instead of position: the radar's geodetic site, one of the pipeline's sites: (within "
-                                "0.01 deg of arc of pipeline.frame_origin)"),
+      ParamSpec::string("site", "instead of position: the radar's geodetic site, one of the pipeline's sites: (it "
+                                "measures from its own horizon there)"),
       sim::sites_param(),
       sim::frame_origin_param(),
       sim::refraction_kind_param("tropospheric refraction bias added to the elevation: none, Clark's model (paper 004) "

@@ -200,8 +200,45 @@ TEST_CASE("sim.radar adds the Clark bias to elevation") {
   CHECK(ray[2].value(2) - plain[2].value(2) == Approx(model.bias(6 * kDeg)).epsilon(0.15));
 }
 
-// A radar placed at a geodetic site: at the frame's origin it is at [0, 0, 0]; a site away from the
-// origin, position and site together, or a clark_* parameter without clark are refused.
+// East, north, up at a geodetic latitude/longitude, as rows, in ECEF (hand-written, independent
+// of the plugin's GeographicLib path).
+Mat3 enu_rows(double lat, double lon) {
+  Mat3 R;
+  R << -std::sin(lon), std::cos(lon), 0.0,
+       -std::sin(lat) * std::cos(lon), -std::sin(lat) * std::sin(lon), std::cos(lat),
+       std::cos(lat) * std::cos(lon), std::cos(lat) * std::sin(lon), std::sin(lat);
+  return R;
+}
+
+// A radar at a site 1.5 deg of arc from the frame's origin measures from its own horizon: a target
+// straight above it (along its ellipsoid normal) is at 90 deg elevation, one due east of it
+// along its own east at 0 deg and azimuth 90 deg, though both are tilted in the frame's axes.
+TEST_CASE("sim.radar at a distant site measures from its own horizon") {
+  const std::string sites =
+      "sites: [{name: naro, latitude: 34.43 deg, longitude: 127.53 deg},"
+      " {name: jeju, latitude: 33.28 deg, longitude: 126.46 deg, height: 100 m}]\nframe_origin: jeju\n";
+  const auto probe = measure(sites + kNoNoise + "site: naro\n", {truth_at(Vec3(0, 0, 0))});
+  REQUIRE(probe.size() == 1);
+  const Vec3 naro = probe[0].sensor_position;
+  CHECK_FALSE(probe[0].sensor_level);
+  CHECK(naro.norm() > 1e5);
+  // Naro's up and east in Jeju's frame: rotate the ECEF directions into Jeju's axes.
+  const Mat3 jeju = enu_rows(33.28 * kDeg, 126.46 * kDeg), at_naro = enu_rows(34.43 * kDeg, 127.53 * kDeg);
+  const Vec3 up = jeju * at_naro.row(2).transpose(), east = jeju * at_naro.row(0).transpose();
+  CHECK(std::acos(up.z()) / kDeg == Approx(1.5).margin(0.1));  // tilted by about its arc from Jeju
+  const auto ms = measure(sites + kNoNoise + "site: naro\n", {truth_at(naro + 10000 * up), truth_at(naro + 20000 * east)});
+  REQUIRE(ms.size() == 2);
+  CHECK(ms[0].value(0) == Approx(10000).epsilon(1e-12));
+  CHECK(ms[0].value(2) == Approx(90 * kDeg).epsilon(1e-9));
+  CHECK(ms[1].value(0) == Approx(20000).epsilon(1e-12));
+  CHECK(ms[1].value(1) == Approx(90 * kDeg).epsilon(1e-9));
+  CHECK(ms[1].value(2) == Approx(0).margin(1e-9));
+  // Its axes travel with the measurement: sensor_axes' (p - sensor) is what it measured.
+  CHECK((ms[1].sensor_axes.col(2) - up).norm() < 1e-9);
+}
+
+// A radar placed at a geodetic site: at the frame's origin it is at [0, 0, 0] and level; position
+// and site together, or a clark_* parameter without clark are refused.
 TEST_CASE("sim.radar site and refraction parameters are checked") {
   const std::string sites =
       "sites: [{name: naro, latitude: 34.43 deg, longitude: 127.53 deg},"
@@ -209,7 +246,7 @@ TEST_CASE("sim.radar site and refraction parameters are checked") {
   const auto ms = measure(sites + kNoNoise + "site: jeju\n", {truth_at(Vec3(0, 1000, 0))});
   CHECK(ms.at(0).sensor_position.norm() < 1e-6);
   CHECK(ms.at(0).value(0) == Approx(1000));
-  CHECK_THAT(config_error(sites + "site: naro"), Catch::Matchers::Contains("frame_origin: naro"));
+  CHECK(ms.at(0).sensor_level);
   CHECK_THAT(config_error(sites + "site: jeju\nposition: [0, 0, 0]"), Catch::Matchers::Contains("'position'"));
   CHECK_THAT(config_error(sites + "site: jej"), Catch::Matchers::Contains("sites: naro, jeju"));
   CHECK_THAT(config_error("clark_theta_unit: deg"), Catch::Matchers::Contains("refraction: clark"));

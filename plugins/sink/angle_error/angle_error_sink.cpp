@@ -83,6 +83,7 @@ class AngleErrorSink final : public Component, public RunResultCodec {
     if (m.frame != Frame::Spherical)
       throw DataError("sink.angle_error: input '" + sources_[slot] + "' delivers " + to_string(m.frame) +
                       " measurements; it scores the radar's own spherical angles (wire the radar, not a converter)");
+    if (!m.sensor_level) throw DataError("sink.angle_error: " + tilted_sensor_message(m));
     if (!m.value.head<3>().allFinite()) {
       ++run_non_finite_[slot];
       return;

@@ -235,7 +235,7 @@ class CsvSink final : public Component, public RunResultCodec {
       }
       if (r.has_sigma) r.covariance.topLeftCorner<3, 3>() = m.covariance.topLeftCorner(3, 3);
     } else {
-      r.value.head<3>() = spherical_to_enu(m.value(0), m.value(1), m.value(2), m.azimuth) + m.sensor_position;
+      r.value.head<3>() = measured_position(m);
     }
     arrived(m.time);
     flush(false);

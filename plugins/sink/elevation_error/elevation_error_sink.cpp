@@ -3,6 +3,8 @@
 #include "../../sim/common/refraction.hpp"
 #include "truth_match.hpp"
 
+#include <trackflow/error.hpp>
+#include <trackflow/geometry.hpp>
 #include <trackflow/plugin.hpp>
 #include <trackflow/run_result_codec.hpp>
 
@@ -90,6 +92,7 @@ class ElevationErrorSink final : public Component, public RunResultCodec {
 
   void on_measurement(const Measurement& m, int) override {
     if (!m.valid || m.frame != Frame::Spherical || m.value.size() < 3) return;
+    if (!m.sensor_level) throw DataError("sink.elevation_error: " + tilted_sensor_message(m));
     items_.push_back({m.time, m.value(2), m.sensor_position, NAN});
   }
 

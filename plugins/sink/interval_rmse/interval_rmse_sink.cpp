@@ -64,7 +64,7 @@ class IntervalRmseSink final : public Component, public RunResultCodec {
     if (!m.valid || m.value.size() < 3 || !m.value.head<3>().allFinite()) return;
     const Vec3 p = m.frame == Frame::Cartesian
                        ? Vec3(m.value.head<3>())
-                       : Vec3(spherical_to_enu(m.value(0), m.value(1), m.value(2), m.azimuth) + m.sensor_position);
+                       : measured_position(m);
     measurements_.push_back({m.time, 0, true, p});
   }
 

@@ -19,6 +19,11 @@ namespace {
 using metrics::EstimateRecord;
 using metrics::MetricsRunResult;
 
+// Several estimates of one run at one time stamp (a filter taking several sensors publishes after
+// each sensor's update; a fusion node after each local estimate): score each, or only the last
+// (the state after every update of that time).
+enum class SameTime { All, Last };
+
 // Items are only stored during a run; everything is evaluated in end_run(), when the truth of
 // the whole run is known (truth of a time step may arrive after the estimate of that step).
 class MetricsSink final : public Component, public RunResultCodec {
@@ -27,7 +32,8 @@ class MetricsSink final : public Component, public RunResultCodec {
       : skip_initial_(p.real("skip_initial")),
         confidence_(p.real("confidence")),
         tolerance_(p.real("time_tolerance")),
-        series_(p.boolean("series")) {
+        series_(p.boolean("series")),
+        last_at_time_(p.choice<SameTime>("same_time") == SameTime::Last) {
     if (!(confidence_ > 0.0 && confidence_ < 1.0))
       throw p.error("confidence", "must lie strictly between 0 and 1 (e.g. 0.95)");
     constexpr size_t kReserve = 4096;
@@ -70,7 +76,9 @@ class MetricsSink final : public Component, public RunResultCodec {
   // Every estimate is kept (uninitialised ones only count towards the per-step fractions).
   void on_estimate(const Estimate& e, int) override {
     if (!e.initialised && !series_) return;
-    StoredEstimate& s = estimates_.emplace_back();
+    const bool replace = last_at_time_ && !estimates_.empty() && std::abs(e.time - estimates_.back().time) <= tolerance_;
+    StoredEstimate& s = replace ? estimates_.back() : estimates_.emplace_back();
+    if (replace) s = StoredEstimate{};
     s.time = e.time;
     s.target = e.target;
     s.initialised = e.initialised;
@@ -87,7 +95,7 @@ class MetricsSink final : public Component, public RunResultCodec {
     if (!m.valid || m.value.size() < 3) return;
     const Vec3 p = m.frame == Frame::Cartesian
                        ? Vec3(m.value.head<3>())
-                       : Vec3(spherical_to_enu(m.value(0), m.value(1), m.value(2), m.azimuth) + m.sensor_position);
+                       : measured_position(m);
     measurements_.push_back({m.time, p});
   }
 
@@ -214,7 +222,7 @@ class MetricsSink final : public Component, public RunResultCodec {
   }
 
   const double skip_initial_, confidence_, tolerance_;
-  const bool series_;
+  const bool series_, last_at_time_;
   bool truth_input_ = false, measurement_input_ = false;
   bool truth_nan_time_ = false;  // a truth sample without a time: samples not in time order
   std::vector<Truth> truth_;
@@ -256,6 +264,11 @@ void register_components(Registrar& r) {
       ParamSpec::real("time_tolerance", dim::time, "items closer in time than this are the same time step")
           .def("1 us")
           .positive(),
+      ParamSpec::choice<SameTime>("same_time", {{SameTime::All, "all"}, {SameTime::Last, "last"}},
+                                  "several estimates of one run at one time (within time_tolerance; a filter with "
+                                  "several sensors, a fusion node): score all, or only the last of them (its ANIS "
+                                  "then sees only that estimate's innovation)")
+          .def("all"),
       ParamSpec::boolean("series",
                          "publish the per-step ensemble series (measurement RMSE, fractions of runs, annotations per "
                          "step); false keeps only what the summary needs")

@@ -345,3 +345,25 @@ TEST_CASE("bad inputs or confidence are config errors") {
   CHECK_THROWS_AS(test::make("sink.metrics", "{ confidence: 1 }"), ConfigError);
   CHECK_THROWS_AS(test::make("sink.metrics", "{ confidence: 0 }"), ConfigError);
 }
+
+// A filter with several sensors publishes twice at a shared time stamp: the first estimate 10 m
+// off, the second (after both updates) exact. same_time: all scores both (RMSE sqrt(100 / 2)
+// over the two at t = 1 plus the exact one at t = 0: sqrt(100 / 3)); same_time: last only the
+// second (RMSE 0, one estimate per time).
+TEST_CASE("metrics: same_time last scores the last estimate only") {
+  auto feed = [](Component& c, int) {
+    c.on_truth(truth(0, Vec3::Zero()), 1);
+    c.on_truth(truth(1, Vec3::Zero()), 1);
+    c.on_estimate(estimate(0, state(0, 0, 0)), 0);
+    c.on_estimate(estimate(1, state(10, 0, 0)), 0);
+    c.on_estimate(estimate(1, state(0, 0, 0)), 0);
+  };
+  const Summary all = run_ensemble("{}", {kFilter, kTruth}, 1, feed);
+  const Summary last = run_ensemble("{same_time: last}", {kFilter, kTruth}, 1, feed);
+  REQUIRE(all.find("position_rmse") != nullptr);
+  REQUIRE(last.find("position_rmse") != nullptr);
+  CHECK(all.find("position_rmse")->value == Approx(std::sqrt(100.0 / 3.0)));
+  CHECK(all.find("estimates")->value == 3);
+  CHECK(last.find("position_rmse")->value == Approx(0.0).margin(1e-12));
+  CHECK(last.find("estimates")->value == 2);
+}

@@ -77,7 +77,7 @@ class TrackSink final : public Component, public RunResultCodec {
       if (m.covariance.rows() >= 3 && m.covariance.cols() >= 3)
         for (int i = 0; i < 3; ++i) sigma(i) = m.covariance(i, i) >= 0.0 ? std::sqrt(m.covariance(i, i)) : kNaN;
     } else {
-      p = spherical_to_enu(m.value(0), m.value(1), m.value(2), m.azimuth) + m.sensor_position;
+      p = measured_position(m);
     }
     s->points.push_back({m.time, kNaN, {p.x(), p.y(), p.z()}, {kNaN, kNaN, kNaN}, {sigma.x(), sigma.y(), sigma.z()}});
   }

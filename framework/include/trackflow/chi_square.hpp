@@ -1,0 +1,17 @@
+// Purpose: the two-sided chi-square acceptance band of a mean of normalised squared errors (NIS, NEES), for summaries.
+#pragma once
+
+#include <boost/config.hpp>
+
+namespace trackflow {
+
+struct ChiSquareBand {
+  double lo = 0.0, hi = 0.0;
+};
+
+// A sum of normalised squared errors with `dof` degrees of freedom in all, divided by `dof`:
+// [chi2inv((1-c)/2, dof), chi2inv((1+c)/2, dof)] / dof. A mean NIS per measurement element inside
+// it is consistent with the filter's innovation covariance at confidence c.
+BOOST_SYMBOL_VISIBLE ChiSquareBand chi_square_mean_band(double dof, double confidence);
+
+}  // namespace trackflow
