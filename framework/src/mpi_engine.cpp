@@ -6,6 +6,7 @@
 #include <trackflow/version.hpp>
 
 #include "mpi_launch.hpp"
+#include "run_one.hpp"
 
 #include <boost/mpi/collectives.hpp>
 #include <boost/mpi/communicator.hpp>
@@ -104,43 +105,6 @@ class Session final : public MpiSession {
   mpi::communicator world_;
 };
 
-struct RunRecord {
-  std::vector<std::unique_ptr<RunResult>> results;  // by node
-  Diagnostics diagnostics;
-  std::uint64_t source_items = 0;
-  std::uint64_t measurements_processed = 0;
-};
-
-// As in engine.cpp: the generator with the earliest next item goes first; ties go to the
-// generator declared first.
-std::uint64_t drive(GraphInstance& inst) {
-  std::vector<Generator*> gens;
-  for (int r : inst.roots) gens.push_back(static_cast<Generator*>(inst.components[r].get()));
-  std::uint64_t items = 0;
-  if (gens.size() == 1) {
-    Generator* g = gens[0];
-    while (std::isfinite(g->next_time())) {
-      g->emit_next();
-      ++items;
-    }
-    return items;
-  }
-  for (;;) {
-    Generator* best = nullptr;
-    double t = std::numeric_limits<double>::infinity();
-    for (Generator* g : gens) {
-      const double gt = g->next_time();
-      if (gt < t) {
-        t = gt;
-        best = g;
-      }
-    }
-    if (!best) return items;
-    best->emit_next();
-    ++items;
-  }
-}
-
 // One instance of the graph on one thread, running whole runs (the steps of engine.cpp's worker).
 struct Runner {
   const Graph& g;
@@ -148,21 +112,10 @@ struct Runner {
   GraphInstance inst;
   std::vector<Filter*> filters;
   Runner(const Graph& graph, const PluginRegistry& registry, const RunOptions& o)
-      : g(graph), opt(o), inst(instantiate(graph, registry)) {
-    for (auto& c : inst.components)
-      if (auto* f = dynamic_cast<Filter*>(c.get())) filters.push_back(f);
-  }
+      : g(graph), opt(o), inst(instantiate(graph, registry)), filters(filters_of(inst)) {}
   RunRecord run(std::uint64_t run) {
     const size_t N = g.nodes.size();
-    RunRecord rec;
-    for (Filter* f : filters) f->reset_adapted_state();
-    for (size_t i = 0; i < N; ++i)
-      inst.components[i]->start_run({run, derive_seed(opt.seed, run, g.nodes[i].config.id), &rec.diagnostics});
-    for (Filter* f : filters) f->take_processed();
-    rec.source_items = drive(inst);
-    for (Filter* f : filters) rec.measurements_processed += f->take_processed();
-    rec.results.resize(N);
-    for (size_t i = 0; i < N; ++i) rec.results[i] = inst.components[i]->end_run();
+    RunRecord rec = run_one(g, inst, filters, opt.seed, run);
     // Checked on every process, whichever runs the run, so the job behaves the same for any -np.
     for (size_t i = 0; i < N; ++i)
       if (rec.results[i] && !dynamic_cast<const RunResultCodec*>(inst.components[i].get()))

@@ -1,0 +1,105 @@
+// Purpose: one Monte Carlo run on one graph instance, shared by the engine and the MPI engine.
+#include "run_one.hpp"
+
+#include <trackflow/rng.hpp>
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <queue>
+#include <utility>
+
+namespace trackflow::host {
+namespace {
+
+// One run on one instance: the generator with the earliest next item goes first; ties go to
+// the generator declared first, so the order never depends on timing. A generator whose next
+// time is not a number is exhausted, as one at +infinity.
+std::uint64_t drive(GraphInstance& inst) {
+  std::vector<Generator*> gens;
+  for (int r : inst.roots) gens.push_back(static_cast<Generator*>(inst.components[r].get()));
+  std::uint64_t items = 0;
+  if (gens.size() == 1) {
+    Generator* g = gens[0];
+    detail::executing = g;
+    while (std::isfinite(g->next_time())) {
+      g->emit_next();
+      ++items;
+    }
+    return items;
+  }
+  if (gens.size() <= 8) {
+    for (;;) {
+      Generator* best = nullptr;
+      double t = std::numeric_limits<double>::infinity();
+      for (Generator* g : gens) {
+        detail::executing = g;
+        const double gt = g->next_time();
+        if (gt < t) {
+          t = gt;
+          best = g;
+        }
+      }
+      if (!best) return items;
+      detail::executing = best;
+      best->emit_next();
+      ++items;
+    }
+  }
+  // Many sources: a heap on (time, declaration order) keeps a step logarithmic. Only the
+  // generator that emitted changes its next time (generators have no inputs).
+  using Entry = std::pair<double, std::size_t>;
+  std::priority_queue<Entry, std::vector<Entry>, std::greater<Entry>> heap;
+  for (std::size_t i = 0; i < gens.size(); ++i) {
+    detail::executing = gens[i];
+    const double t = gens[i]->next_time();
+    if (t < std::numeric_limits<double>::infinity()) heap.emplace(t, i);
+  }
+  while (!heap.empty()) {
+    const std::size_t i = heap.top().second;
+    heap.pop();
+    detail::executing = gens[i];
+    gens[i]->emit_next();
+    ++items;
+    const double t = gens[i]->next_time();
+    if (t < std::numeric_limits<double>::infinity()) heap.emplace(t, i);
+  }
+  return items;
+}
+
+}  // namespace
+
+std::vector<Filter*> filters_of(GraphInstance& inst) {
+  std::vector<Filter*> filters;
+  for (auto& c : inst.components)
+    if (auto* f = dynamic_cast<Filter*>(c.get())) filters.push_back(f);
+  return filters;
+}
+
+RunRecord run_one(const Graph& g, GraphInstance& inst, const std::vector<Filter*>& filters, std::uint64_t seed,
+                  std::uint64_t run) {
+  const std::size_t N = g.nodes.size();
+  RunRecord rec;
+  // The engine, not each filter's discipline, puts back what adapters tuned in the previous
+  // run on this instance: otherwise results would depend on which thread ran which run.
+  for (Filter* f : filters) {
+    detail::executing = f;
+    f->reset_adapted_state();
+  }
+  for (std::size_t i = 0; i < N; ++i) {
+    detail::executing = inst.components[i].get();
+    inst.components[i]->start_run({run, derive_seed(seed, run, g.nodes[i].config.id), &rec.diagnostics});
+  }
+  for (Filter* f : filters) f->take_processed();  // a failed earlier run may have left counts
+  rec.source_items = drive(inst);
+  for (Filter* f : filters) rec.measurements_processed += f->take_processed();
+  rec.results.resize(N);
+  for (std::size_t i = 0; i < N; ++i) {
+    detail::executing = inst.components[i].get();
+    rec.results[i] = inst.components[i]->end_run();
+  }
+  detail::executing = nullptr;
+  return rec;
+}
+
+}  // namespace trackflow::host

@@ -1,0 +1,31 @@
+// Purpose: one Monte Carlo run on one graph instance — the engine's and the MPI engine's shared step: resets, start_run, the time-ordered merge of the sources, end_run.
+#pragma once
+
+#include <trackflow/component.hpp>
+#include <trackflow/host/graph.hpp>
+
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+namespace trackflow::host {
+
+// What one run leaves for the ordered reduction.
+struct RunRecord {
+  std::vector<std::unique_ptr<RunResult>> results;  // by node
+  Diagnostics diagnostics;
+  std::uint64_t source_items = 0;
+  std::uint64_t measurements_processed = 0;
+};
+
+// The filters of an instance (the engine resets their adapted noise before every run).
+std::vector<Filter*> filters_of(GraphInstance& inst);
+
+// Runs `run` on `inst`: the adapters' tuning put back (so results never depend on which thread
+// or process ran which run), start_run with the run's per-node seeds, the sources merged in time
+// order (ties to the generator declared first), end_run. Marks the executing node for the crash
+// handler; exceptions pass through (callers name the run and the plugin).
+RunRecord run_one(const Graph& g, GraphInstance& inst, const std::vector<Filter*>& filters, std::uint64_t seed,
+                  std::uint64_t run);
+
+}  // namespace trackflow::host
