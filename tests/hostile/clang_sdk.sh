@@ -40,7 +40,15 @@ grep -q 'CMAKE_CXX_COMPILER_ID.*Clang\|The CXX compiler identification is Clang'
 cmake --build "$tmp/build" -j 2 >"$log" 2>&1 || fail "building examples/alpha_beta_plugin with clang++ failed"
 echo "ok: examples/alpha_beta_plugin builds with clang++ against the installed SDK"
 if [ -x "$tmp/build/test_alpha_beta" ]; then
+  # Under `setup.sh sanitize` the installed library is built with GCC's AddressSanitizer while
+  # the clang-built test executable is not: the ASan runtime must then come first (LD_PRELOAD),
+  # or its exception interceptors miss the throws and leave stale stack poison behind (a false
+  # stack-buffer-overflow in the next call into the library).
+  if [ -n "${TRACKFLOW_SANITIZE:-}" ]; then
+    export LD_PRELOAD="$(g++ -print-file-name=libasan.so)${LD_PRELOAD:+:$LD_PRELOAD}"
+  fi
   ctest --test-dir "$tmp/build" >"$log" 2>&1 || fail "the example's tests (clang build) failed"
+  unset LD_PRELOAD
   echo "ok: its tests pass"
 fi
 "$prefix/bin/trackflow" run "$repo/examples/alpha_beta_plugin/alpha_beta.yaml" --plugin-path "$tmp/build" --no-progress \
