@@ -5,32 +5,7 @@ TF=$1
 source "$(dirname "$0")/lib.sh"
 
 # A valid base pipeline; each case below breaks one thing.
-base() {
-  cat <<'YAML'
-pipeline: { name: errors, seed: 1, runs: 1 }
-nodes:
-  - id: truth
-    type: sim.trajectory
-    params:
-      rate: 10 Hz
-      initial_position: [6000, 8000, 1000]
-      initial_velocity: [-150, 50, 0]
-      segments: [ { type: constant_velocity, duration: 5 s } ]
-  - id: radar
-    type: sim.radar
-    input: truth
-    params: { sigma_range: 10 m }
-  - id: cm
-    type: convert.classical
-    input: radar
-  - id: kf
-    type: filter.kalman
-    input: cm
-  - id: score
-    type: sink.metrics
-    inputs: [kf, truth]
-YAML
-}
+base() { base_pipeline errors 1; }
 
 base > "$TMP/ok.yaml"
 expect_run "valid pipeline validates" 0 "ok" -- "$TF" validate "$TMP/ok.yaml"

@@ -31,3 +31,32 @@ expect_run() {
 finish() {
   echo "$checks passed, 0 failed"
 }
+
+# base_pipeline NAME RUNS: a valid pipeline (5 s at 10 Hz through sim.radar, convert.classical,
+# filter.kalman and sink.metrics) that a test copies and breaks one thing in.
+base_pipeline() {
+  cat <<YAML
+pipeline: { name: $1, seed: 1, runs: $2 }
+nodes:
+  - id: truth
+    type: sim.trajectory
+    params:
+      rate: 10 Hz
+      initial_position: [6000, 8000, 1000]
+      initial_velocity: [-150, 50, 0]
+      segments: [ { type: constant_velocity, duration: 5 s } ]
+  - id: radar
+    type: sim.radar
+    input: truth
+    params: { sigma_range: 10 m }
+  - id: cm
+    type: convert.classical
+    input: radar
+  - id: kf
+    type: filter.kalman
+    input: cm
+  - id: score
+    type: sink.metrics
+    inputs: [kf, truth]
+YAML
+}

@@ -9,32 +9,7 @@ source "$(dirname "${BASH_SOURCE[0]}")/../cli/lib.sh"
 unset TRACKFLOW_PLUGIN_PATH
 
 # A valid pipeline (5 s at 10 Hz, 2 runs); each case breaks one thing in a copy.
-base() {
-  cat <<'YAML'
-pipeline: { name: hostile, seed: 1, runs: 2 }
-nodes:
-  - id: truth
-    type: sim.trajectory
-    params:
-      rate: 10 Hz
-      initial_position: [6000, 8000, 1000]
-      initial_velocity: [-150, 50, 0]
-      segments: [ { type: constant_velocity, duration: 5 s } ]
-  - id: radar
-    type: sim.radar
-    input: truth
-    params: { sigma_range: 10 m }
-  - id: cm
-    type: convert.classical
-    input: radar
-  - id: kf
-    type: filter.kalman
-    input: cm
-  - id: score
-    type: sink.metrics
-    inputs: [kf, truth]
-YAML
-}
+base() { base_pipeline hostile 2; }
 
 # expect_no <what> <regex> <file>: the file must not match (e.g. no NaN written).
 expect_no() {
