@@ -421,13 +421,13 @@ void annotation_section(Page& page, const std::vector<Scored>& scored) {
     std::vector<Line> fractions = {column_line(*s.series, "initialised_fraction", "initialised"),
                                    column_line(*s.series, "updated_fraction", "updated")};
     if (!header) {
-      page.html("<h2>Filter state and adapter annotations against time</h2>\n");
+      page.html("<h2>Filter state and annotations (the filter's own and its adapters') against time</h2>\n");
       header = true;
     }
     const std::string label = label_for(s, scored);
     page.chart(line_chart("fraction of runs initialised and updated - " + label, "time [s]", "fraction of runs", fractions));
     if (!lines.empty()) {
-      Chart c = line_chart("adapter annotations (mean over runs) - " + label, "time [s]", "mean value", lines);
+      Chart c = line_chart("annotations (mean over runs) - " + label, "time [s]", "mean value", lines);
       c.caption = "per channel: mean over the runs of the value the adapters attached to the estimate "
                   "(<adapter>.grade_*: quality grades, 0 best, 1 normal, 2 worst; <adapter>.sigma_*: adapted R, m)";
       page.chart(c);
