@@ -32,8 +32,8 @@ struct InnovationRRunResult final : RunResult {
   // Its codec under mpirun (run_result_codec.hpp): one list, written and read in this order.
   template <class Self, class F>
   static void fields(Self& r, F&& f) {
-    f(r.has_estimate, r.sigma, r.nominal_sigma, r.noise_factor, r.factor_sum, r.factor_count, r.updates, r.floored, r.rescales,
-      r.variance_factor);
+    f(r.has_estimate, r.sigma, r.nominal_sigma, r.noise_factor, r.factor_sum, r.factor_count, r.updates, r.floored,
+      r.rescales, r.variance_factor);
   }
 };
 
