@@ -81,7 +81,7 @@ class ByteWriter {
   template <class T>
   void put_one(const T& v) {
     if constexpr (FieldRecord<T>) {
-      T::fields(v, [this](const auto&... f) { put_all(f...); });
+      T::fields(v, [&w = *this](const auto&... f) { w.put_all(f...); });
     } else if constexpr (codec_detail::EigenMatrix<T>) {
       if constexpr (!codec_detail::is_fixed_eigen<T>) {
         put(static_cast<std::uint64_t>(v.rows()));
@@ -154,7 +154,7 @@ class ByteReader {
   template <class T>
   void get_one(T& v) {
     if constexpr (FieldRecord<T>) {
-      T::fields(v, [this](auto&... f) { get_all(f...); });
+      T::fields(v, [&r = *this](auto&... f) { r.get_all(f...); });
     } else if constexpr (codec_detail::EigenMatrix<T>) {
       if constexpr (!codec_detail::is_fixed_eigen<T>) {
         const auto rows = get<std::uint64_t>(), cols = get<std::uint64_t>();
