@@ -1,5 +1,6 @@
 // Purpose: adapt.fading_memory — example third-party adapter: fading-memory Kalman filtering by rescaling the attached filter's state covariance before every update.
 #include <trackflow/plugin.hpp>
+#include <trackflow/run_result_codec.hpp>
 
 #include <cmath>
 #include <memory>
@@ -8,13 +9,23 @@ namespace {
 
 using namespace trackflow;
 
+// The adapter's per-run result. Its one field list is its codec under mpirun (FieldListCodec):
+// the processes of the job each run some runs and send these to the first, which merges them.
+struct ScaleCount final : RunResult {
+  std::uint64_t scales = 0;
+  template <class Self, class F>
+  static void fields(Self& r, F&& f) {
+    f(r.scales);
+  }
+};
+
 // Fading memory (Sorenson & Sacks 1971; Bar-Shalom, Li & Kirubarajan 2001, §5.2.4 and §11.7):
 // P⁻ = α² F P Fᵀ + Q with α ≥ 1 weights old data less, which keeps a filter responsive to
 // unmodelled manoeuvres. Multiplying P by α² before the filter predicts and updates with a
 // measurement is the same thing up to where Q is added (α² scales P, then F P Fᵀ + Q): done here
 // through the SDK's covariance handle (Filter::scale_covariance), so it works with any filter
 // that has one, whatever its state or how it stores P.
-class FadingMemoryAdapter final : public Adapter {
+class FadingMemoryAdapter final : public Adapter, public FieldListCodec<ScaleCount> {
  public:
   explicit FadingMemoryAdapter(double alpha) : factor_(alpha * alpha) {}
 
@@ -40,20 +51,17 @@ class FadingMemoryAdapter final : public Adapter {
   }
 
   std::unique_ptr<RunResult> end_run() override {
-    auto r = std::make_unique<Count>();
+    auto r = std::make_unique<ScaleCount>();
     r->scales = scales_;
     return r;
   }
-  void merge(RunResult& r) override { total_ += static_cast<Count&>(r).scales; }
+  void merge(RunResult& r) override { total_ += static_cast<ScaleCount&>(r).scales; }
   void finish(Summary& s, const FinishContext&) override {
     s.metric("covariance_rescales", static_cast<double>(total_));
     s.metric("variance_factor", factor_);
   }
 
  private:
-  struct Count final : RunResult {
-    std::uint64_t scales = 0;
-  };
   double factor_;
   std::uint64_t scales_ = 0, total_ = 0;
 };

@@ -14,6 +14,11 @@ using namespace trackflow;
 
 struct DumpRunResult final : RunResult {
   std::string rows;
+  // Its codec under mpirun (run_result_codec.hpp).
+  template <class Self, class F>
+  static void fields(Self& r, F&& f) {
+    f(r.rows);
+  }
 };
 
 // One row per kept estimate:
@@ -21,7 +26,7 @@ struct DumpRunResult final : RunResult {
 // Rows of a run are kept for its first `head` estimates and then every `every`-th one (the
 // errors of a filter propagate to later steps, so sampled rows still see any change), for runs
 // below `runs`. Values are "%.17g": a double survives the round trip exactly.
-class EstimateDump final : public Component, public RunResultCodec {
+class EstimateDump final : public Component, public FieldListCodec<DumpRunResult> {
  public:
   explicit EstimateDump(const Params& p)
       : head_(p.integer("head")), every_(p.integer("every")), runs_(p.integer("runs")) {
@@ -65,16 +70,6 @@ class EstimateDump final : public Component, public RunResultCodec {
     auto r = std::make_unique<DumpRunResult>();
     r->rows = std::move(rows_);
     rows_.clear();
-    return r;
-  }
-
-  // The run's rows cross processes under mpirun (run_result_codec.hpp).
-  void save_run_result(const RunResult& r, ByteWriter& out) const override {
-    out.put_string(static_cast<const DumpRunResult&>(r).rows);
-  }
-  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override {
-    auto r = std::make_unique<DumpRunResult>();
-    r->rows = in.get_string();
     return r;
   }
 

@@ -49,6 +49,12 @@ struct FrontEndRunResult final : RunResult {
   std::uint64_t port_updates[kMaxPorts] = {};
   double port_nis[kMaxPorts] = {};
   std::uint64_t port_dof[kMaxPorts] = {};
+  // Its codec under mpirun (run_result_codec.hpp): one list, written and read in this order.
+  template <class Self, class F>
+  static void fields(Self& r, F&& f) {
+    f(r.updates, r.coasted, r.non_finite, r.rejected, r.counters, r.refused_non_finite, r.port_updates, r.port_nis,
+      r.port_dof);
+  }
 };
 
 // The template method of every filter (CRTP: no virtual call on the hot path). Derived provides
@@ -153,32 +159,12 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
     return std::make_unique<FrontEndRunResult>(run_);
   }
 
-  // Per-run counts cross processes as bytes (mpirun; run_result_codec.hpp).
-  void save_run_result(const RunResult& result, ByteWriter& out) const final {
-    const auto& r = static_cast<const FrontEndRunResult&>(result);
-    out.put(r.updates);
-    out.put(r.coasted);
-    out.put(r.non_finite);
-    out.put(r.rejected);
-    out.put(r.counters);
-    out.put(r.refused_non_finite);
-    out.put(r.port_updates);
-    out.put(r.port_nis);
-    out.put(r.port_dof);
-  }
-  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const final {
-    auto r = std::make_unique<FrontEndRunResult>();
-    in.get(r->updates);
-    in.get(r->coasted);
-    in.get(r->non_finite);
-    in.get(r->rejected);
-    in.get(r->counters);
-    in.get(r->refused_non_finite);
-    in.get(r->port_updates);
-    in.get(r->port_nis);
-    in.get(r->port_dof);
-    return r;
-  }
+  // Per-run counts cross processes as bytes (mpirun; run_result_codec.hpp) by FrontEndRunResult's
+  // field list: FieldListCodec's two functions, called from this class's own `final` overrides so
+  // that its base classes (and layout) stay what ABI 4 plugins were built with.
+  using Codec = FieldListCodec<FrontEndRunResult>;
+  void save_run_result(const RunResult& r, ByteWriter& out) const final { Codec::save_fields(r, out); }
+  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const final { return Codec::load_fields(in); }
 
   void merge(RunResult& result) final {
     const auto& r = static_cast<const FrontEndRunResult&>(result);

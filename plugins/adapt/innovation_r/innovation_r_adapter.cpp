@@ -29,6 +29,12 @@ struct InnovationRRunResult final : RunResult {
   std::uint64_t factor_count = 0;
   std::uint64_t updates = 0, floored = 0, rescales = 0;
   double variance_factor = 1.0;  // the covariance rescale applied over the run (covariance: follow_r)
+  // Its codec under mpirun (run_result_codec.hpp): one list, written and read in this order.
+  template <class Self, class F>
+  static void fields(Self& r, F&& f) {
+    f(r.has_estimate, r.sigma, r.nominal_sigma, r.noise_factor, r.factor_sum, r.factor_count, r.updates, r.floored,
+      r.rescales, r.variance_factor);
+  }
 };
 
 // How much larger than the measurements' own R the estimate is: sqrt of the mean generalised
@@ -39,7 +45,7 @@ double noise_factor(const ResidualREstimator& e) {
   return std::sqrt(std::max(0.0, llt.solve(e.estimate()).trace() / 3.0));
 }
 
-class InnovationRAdapter final : public Adapter, public RunResultCodec {
+class InnovationRAdapter final : public Adapter, public FieldListCodec<InnovationRRunResult> {
  public:
   InnovationRAdapter(adapt::EstimatorSettings s, bool follow_r, bool warmup_differences)
       : settings_(s), estimator_(s), follow_r_(follow_r), warmup_differences_(warmup_differences) {}
@@ -124,35 +130,6 @@ class InnovationRAdapter final : public Adapter, public RunResultCodec {
     r->factor_sum = run_factor_sum_;
     r->variance_factor = applied_variance_factor_;
     r->factor_count = run_factor_count_;
-    return r;
-  }
-
-  // The end-of-run state crosses processes under mpirun (run_result_codec.hpp).
-  void save_run_result(const RunResult& result, ByteWriter& out) const override {
-    const auto& r = static_cast<const InnovationRRunResult&>(result);
-    out.put(r.has_estimate);
-    out.put_matrix(r.sigma);
-    out.put_matrix(r.nominal_sigma);
-    out.put(r.noise_factor);
-    out.put(r.factor_sum);
-    out.put(r.factor_count);
-    out.put(r.updates);
-    out.put(r.floored);
-    out.put(r.rescales);
-    out.put(r.variance_factor);
-  }
-  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override {
-    auto r = std::make_unique<InnovationRRunResult>();
-    in.get(r->has_estimate);
-    in.get_matrix(r->sigma);
-    in.get_matrix(r->nominal_sigma);
-    in.get(r->noise_factor);
-    in.get(r->factor_sum);
-    in.get(r->factor_count);
-    in.get(r->updates);
-    in.get(r->floored);
-    in.get(r->rescales);
-    in.get(r->variance_factor);
     return r;
   }
 

@@ -50,9 +50,14 @@ struct QualityRunResult final : RunResult {
   std::uint64_t graded_in[2][kChannels][kGrades] = {};  // the same per table in force (beacon, skin)
   double rms_sum[kChannels] = {};
   std::uint64_t rms_count[kChannels] = {};
+  // Its codec under mpirun (run_result_codec.hpp): one list, written and read in this order.
+  template <class Self, class F>
+  static void fields(Self& r, F&& f) {
+    f(r.steps, r.invalid, r.resets, r.switches, r.ungraded, r.table_steps, r.graded, r.graded_in, r.rms_sum, r.rms_count);
+  }
 };
 
-class QualitySwitchAdapter final : public Adapter, public RunResultCodec {
+class QualitySwitchAdapter final : public Adapter, public FieldListCodec<QualityRunResult> {
  public:
   explicit QualitySwitchAdapter(const Settings& s)
       : s_(s),
@@ -132,35 +137,6 @@ class QualitySwitchAdapter final : public Adapter, public RunResultCodec {
   }
 
   std::unique_ptr<RunResult> end_run() override { return std::make_unique<QualityRunResult>(run_); }
-
-  // Per-run counts cross processes under mpirun (run_result_codec.hpp).
-  void save_run_result(const RunResult& result, ByteWriter& out) const override {
-    const auto& r = static_cast<const QualityRunResult&>(result);
-    out.put(r.steps);
-    out.put(r.invalid);
-    out.put(r.resets);
-    out.put(r.switches);
-    out.put(r.ungraded);
-    out.put(r.table_steps);
-    out.put(r.graded);
-    out.put(r.graded_in);
-    out.put(r.rms_sum);
-    out.put(r.rms_count);
-  }
-  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override {
-    auto r = std::make_unique<QualityRunResult>();
-    in.get(r->steps);
-    in.get(r->invalid);
-    in.get(r->resets);
-    in.get(r->switches);
-    in.get(r->ungraded);
-    in.get(r->table_steps);
-    in.get(r->graded);
-    in.get(r->graded_in);
-    in.get(r->rms_sum);
-    in.get(r->rms_count);
-    return r;
-  }
 
   void merge(RunResult& result) override {
     const auto& r = static_cast<QualityRunResult&>(result);

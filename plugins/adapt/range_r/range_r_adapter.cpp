@@ -18,13 +18,18 @@ struct RangeRRunResult final : RunResult {
   double sum = 0.0, thermal_sum = 0.0;  // of R and its thermal part over the adapted updates, rad^2
   double min = std::numeric_limits<double>::infinity(), max = 0.0;
   std::uint64_t adapted = 0, skipped = 0;
+  // Its codec under mpirun (run_result_codec.hpp): one list, written and read in this order.
+  template <class Self, class F>
+  static void fields(Self& r, F&& f) {
+    f(r.sum, r.thermal_sum, r.min, r.max, r.adapted, r.skipped);
+  }
 };
 
 // Written before each update into the filter's R (a spherical [range, azimuth, elevation(, range rate)]
 // R): the azimuth and elevation variances become R(r) at the measured range (paper 003 assumes range is
 // tracked perfectly, so the measurement's range is the range), their correlations with the other
 // channels are removed; range and range-rate entries stay the measurement's own.
-class RangeRAdapter final : public Adapter, public RunResultCodec {
+class RangeRAdapter final : public Adapter, public FieldListCodec<RangeRRunResult> {
  public:
   explicit RangeRAdapter(RangeLaw law) : law_(law) {}
 
@@ -61,27 +66,6 @@ class RangeRAdapter final : public Adapter, public RunResultCodec {
   }
 
   std::unique_ptr<RunResult> end_run() override { return std::make_unique<RangeRRunResult>(run_); }
-
-  // The run's sums cross processes under mpirun, bit for bit (run_result_codec.hpp).
-  void save_run_result(const RunResult& result, ByteWriter& out) const override {
-    const auto& r = static_cast<const RangeRRunResult&>(result);
-    out.put(r.sum);
-    out.put(r.thermal_sum);
-    out.put(r.min);
-    out.put(r.max);
-    out.put(r.adapted);
-    out.put(r.skipped);
-  }
-  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override {
-    auto r = std::make_unique<RangeRRunResult>();
-    in.get(r->sum);
-    in.get(r->thermal_sum);
-    in.get(r->min);
-    in.get(r->max);
-    in.get(r->adapted);
-    in.get(r->skipped);
-    return r;
-  }
 
   void merge(RunResult& result) override {
     const auto& r = static_cast<const RangeRRunResult&>(result);

@@ -19,6 +19,11 @@ enum class EvaluateAt { Measured, Solved };
 
 struct ClarkRunResult final : RunResult {
   std::uint64_t corrected = 0, invalid = 0;
+  // Its codec under mpirun (run_result_codec.hpp): one list, written and read in this order.
+  template <class Self, class F>
+  static void fields(Self& r, F&& f) {
+    f(r.corrected, r.invalid);
+  }
 };
 
 // theta_c = theta_m - b(theta_e); range, azimuth and range rate pass unchanged. The elevation
@@ -26,7 +31,7 @@ struct ClarkRunResult final : RunResult {
 // measured point, 1 / (1 + b'(theta_c)) when solved). Below 2 deg clark_below_2deg decides:
 // invalid passes the measurement on with valid = false (counted; filters coast), hold uses b(2 deg),
 // extrapolate the 2-10 deg formula. Invalid measurements pass through untouched.
-class ClarkElevation final : public Component, public RunResultCodec {
+class ClarkElevation final : public Component, public FieldListCodec<ClarkRunResult> {
  public:
   ClarkElevation(sim::ClarkModel model, EvaluateAt at, int iterations)
       : model_(model), at_(at), iterations_(iterations) {}
@@ -62,18 +67,6 @@ class ClarkElevation final : public Component, public RunResultCodec {
   }
 
   std::unique_ptr<RunResult> end_run() override { return std::make_unique<ClarkRunResult>(run_); }
-  // The run's counts cross processes under mpirun (run_result_codec.hpp).
-  void save_run_result(const RunResult& result, ByteWriter& out) const override {
-    const auto& c = static_cast<const ClarkRunResult&>(result);
-    out.put(c.corrected);
-    out.put(c.invalid);
-  }
-  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override {
-    auto c = std::make_unique<ClarkRunResult>();
-    in.get(c->corrected);
-    in.get(c->invalid);
-    return c;
-  }
   void merge(RunResult& r) override {
     const auto& c = static_cast<ClarkRunResult&>(r);
     total_.corrected += c.corrected;

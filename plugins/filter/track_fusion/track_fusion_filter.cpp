@@ -35,6 +35,11 @@ constexpr int kMaxInputs = 8;
 struct FusionRunResult final : RunResult {
   std::uint64_t fused = 0, restarts = 0, ci_count = 0;
   double ci_weight_sum = 0.0;
+  // Its codec under mpirun (run_result_codec.hpp): one list, written and read in this order.
+  template <class Self, class F>
+  static void fields(Self& r, F&& f) {
+    f(r.fused, r.restarts, r.ci_count, r.ci_weight_sum);
+  }
 };
 
 // The local filters' estimates arrive in time order (the engine's merge; equal time stamps in
@@ -42,7 +47,7 @@ struct FusionRunResult final : RunResult {
 // input (CI: predicted to that time with the motion model), or folded into the fused track
 // (information), and the fused estimate is published at that time.
 template <int Order>
-class TrackFusion final : public Component, public RunResultCodec {
+class TrackFusion final : public Component, public FieldListCodec<FusionRunResult> {
   using Model = KinematicModel<Order>;
   static constexpr int N = Model::kDim;
   using Vec = Eigen::Matrix<double, N, 1>;
@@ -94,21 +99,6 @@ class TrackFusion final : public Component, public RunResultCodec {
   }
 
   std::unique_ptr<RunResult> end_run() override { return std::make_unique<FusionRunResult>(run_); }
-  void save_run_result(const RunResult& result, ByteWriter& out) const override {
-    const auto& r = static_cast<const FusionRunResult&>(result);
-    out.put(r.fused);
-    out.put(r.restarts);
-    out.put(r.ci_count);
-    out.put(r.ci_weight_sum);
-  }
-  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override {
-    auto r = std::make_unique<FusionRunResult>();
-    in.get(r->fused);
-    in.get(r->restarts);
-    in.get(r->ci_count);
-    in.get(r->ci_weight_sum);
-    return r;
-  }
   void merge(RunResult& result) override {
     const auto& r = static_cast<const FusionRunResult&>(result);
     total_.fused += r.fused;

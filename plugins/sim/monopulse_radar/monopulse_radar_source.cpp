@@ -28,13 +28,19 @@ double from_db(double db) { return std::pow(10.0, db / 10.0); }
 
 struct MonopulseRunResult final : RunResult {
   sim::ProcessStatistics stats;
+  // Its codec under mpirun (run_result_codec.hpp): the statistics go as the struct's bytes (plain
+  // numbers, same build on every process), so a field added to them later travels without a change here.
+  template <class Self, class F>
+  static void fields(Self& r, F&& f) {
+    f(r.stats);
+  }
 };
 
 // Independent streams per effect (derived from the run's seed), so switching one effect off leaves the
 // draws of the others unchanged: an ablation compares the same realisations.
 enum Stream : std::uint64_t { kRangeStream = 1, kRcsStream = 2, kGlintStream = 3, kThermalStream = 4 };
 
-class MonopulseRadar final : public Component, public RunResultCodec {
+class MonopulseRadar final : public Component, public FieldListCodec<MonopulseRunResult> {
  public:
   explicit MonopulseRadar(const Params& p)
       : node_(p.node()),
@@ -228,17 +234,6 @@ class MonopulseRadar final : public Component, public RunResultCodec {
   std::unique_ptr<RunResult> end_run() override {
     auto r = std::make_unique<MonopulseRunResult>();
     r->stats = run_;
-    return r;
-  }
-
-  // The run's sums cross processes under mpirun as the struct's bytes (plain numbers, same build on
-  // every process: run_result_codec.hpp), so a field added later travels without a change here.
-  void save_run_result(const RunResult& result, ByteWriter& out) const override {
-    out.put(static_cast<const MonopulseRunResult&>(result).stats);
-  }
-  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override {
-    auto r = std::make_unique<MonopulseRunResult>();
-    in.get(r->stats);
     return r;
   }
 

@@ -58,8 +58,12 @@ RadarPlace radar_place(const Params& p) {
 // Per-run count of measurements the refraction model left undefined (flagged invalid).
 struct RadarRunResult final : RunResult {
   std::uint64_t refraction_invalid = 0;
+  // Its codec under mpirun (run_result_codec.hpp): one list, written and read in this order.
+  template <class Self, class F>
+  static void fields(Self& r, F&& f) {
+    f(r.refraction_invalid);
+  }
 };
-
 
 // A shot_* parameter written while shot noise is off would be silently ignored.
 void check_shot_params(const Params& p, const sim::ShotNoise& shot) {
@@ -77,7 +81,7 @@ void check_shot_params(const Params& p, const sim::ShotNoise& shot) {
 // The reported covariance is diag σ² of the σ's this look used, except that a shot-noise
 // burst is not in it (the radar does not know); the biases are a systematic error the
 // downstream filter is not told about.
-class RadarSource final : public Component, public RunResultCodec {
+class RadarSource final : public Component, public FieldListCodec<RadarRunResult> {
  public:
   explicit RadarSource(const Params& p)
       : node_(p.node()),
@@ -171,15 +175,6 @@ class RadarSource final : public Component, public RunResultCodec {
     if (refraction_.kind == sim::RefractionKind::None) return nullptr;
     auto r = std::make_unique<RadarRunResult>();
     r->refraction_invalid = refraction_invalid_;
-    return r;
-  }
-  // The refraction counter crosses processes under mpirun (run_result_codec.hpp).
-  void save_run_result(const RunResult& result, ByteWriter& out) const override {
-    out.put(static_cast<const RadarRunResult&>(result).refraction_invalid);
-  }
-  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override {
-    auto r = std::make_unique<RadarRunResult>();
-    in.get(r->refraction_invalid);
     return r;
   }
   void merge(RunResult& r) override { total_refraction_invalid_ += static_cast<RadarRunResult&>(r).refraction_invalid; }

@@ -29,12 +29,17 @@ struct AngleRunResult final : RunResult {
   IntervalTable table;
   std::vector<std::uint64_t> missed, non_finite;  // per source
   std::uint64_t unmatched = 0;
+  // Its codec under mpirun (run_result_codec.hpp): one list, written and read in this order.
+  template <class Self, class F>
+  static void fields(Self& r, F&& f) {
+    f(r.table.sums(), r.missed, r.non_finite, r.unmatched);
+  }
 };
 
 // Items are kept during the run (capacity reused, so nothing is allocated once the first run has
 // sized the buffers) and scored in end_run(): the truth and the radar's position are known by then,
 // whatever order the pipeline delivers them in.
-class AngleErrorSink final : public Component, public RunResultCodec {
+class AngleErrorSink final : public Component, public FieldListCodec<AngleRunResult> {
  public:
   AngleErrorSink(std::vector<Interval> intervals, std::optional<Vec3> radar, AzimuthConvention convention, double tolerance)
       : intervals_(std::move(intervals)), radar_(radar), convention_(convention), tolerance_(tolerance) {
@@ -144,23 +149,14 @@ class AngleErrorSink final : public Component, public RunResultCodec {
     return r;
   }
 
-  // The run's interval sums and counts cross processes under mpirun, bit for bit
-  // (run_result_codec.hpp); the receiving instance has the same intervals and inputs.
-  void save_run_result(const RunResult& result, ByteWriter& out) const override {
-    const auto& r = static_cast<const AngleRunResult&>(result);
-    out.put_vector(r.table.sums());
-    out.put_vector(r.missed);
-    out.put_vector(r.non_finite);
-    out.put(r.unmatched);
-  }
+  // Under mpirun (run_result_codec.hpp) the receiving instance has the same intervals and inputs:
+  // the table is shaped from them before the field list is read, and the sizes merge() indexes
+  // by are checked (writing is FieldListCodec's).
   std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override {
     auto r = std::make_unique<AngleRunResult>();
     r->table = IntervalTable(intervals_.size(), sources_.size());
     const std::size_t cells = r->table.sums().size();
-    in.get_vector(r->table.sums());
-    in.get_vector(r->missed);
-    in.get_vector(r->non_finite);
-    in.get(r->unmatched);
+    in.get_all(*r);
     if (r->table.sums().size() != cells || r->missed.size() != sources_.size() ||
         r->non_finite.size() != sources_.size())
       throw DataError("sink.angle_error: a run's result from another process has another table size");

@@ -29,6 +29,11 @@ struct Sample {
 struct ElevationRunResult final : RunResult {
   std::vector<Sample> samples;  // scored samples of the run, in time order
   std::uint64_t non_finite = 0, unmatched = 0;
+  // Its codec under mpirun (run_result_codec.hpp): one list, written and read in this order.
+  template <class Self, class F>
+  static void fields(Self& r, F&& f) {
+    f(r.samples, r.non_finite, r.unmatched);
+  }
 };
 
 // Per-step sums over runs (the k-th scored sample of every run; the runs share their times when
@@ -38,7 +43,7 @@ struct StepSums {
   std::uint64_t n = 0;
 };
 
-class ElevationErrorSink final : public Component, public RunResultCodec {
+class ElevationErrorSink final : public Component, public FieldListCodec<ElevationRunResult> {
  public:
   explicit ElevationErrorSink(const Params& p)
       : below_(p.real_or("below", std::numeric_limits<double>::infinity())),
@@ -124,21 +129,6 @@ class ElevationErrorSink final : public Component, public RunResultCodec {
       }
       r->samples.push_back(s);
     }
-    return r;
-  }
-
-  // The run's scored samples cross processes under mpirun, bit for bit (run_result_codec.hpp).
-  void save_run_result(const RunResult& result, ByteWriter& out) const override {
-    const auto& r = static_cast<const ElevationRunResult&>(result);
-    out.put_vector(r.samples);
-    out.put(r.non_finite);
-    out.put(r.unmatched);
-  }
-  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override {
-    auto r = std::make_unique<ElevationRunResult>();
-    in.get_vector(r->samples);
-    in.get(r->non_finite);
-    in.get(r->unmatched);
     return r;
   }
 

@@ -23,10 +23,15 @@ struct Bin {
 struct IntervalRunResult final : RunResult {
   std::vector<Bin> bins;
   std::uint64_t non_finite = 0, unmatched = 0;
+  // Its codec under mpirun (run_result_codec.hpp): one list, written and read in this order.
+  template <class Self, class F>
+  static void fields(Self& r, F&& f) {
+    f(r.bins, r.non_finite, r.unmatched);
+  }
 };
 
 // Items are stored during the run and scored in end_run(), when all truth has arrived.
-class IntervalRmseSink final : public Component, public RunResultCodec {
+class IntervalRmseSink final : public Component, public FieldListCodec<IntervalRunResult> {
  public:
   IntervalRmseSink(double start, double interval, double skip_initial, double tolerance)
       : start_(start), interval_(interval), skip_initial_(skip_initial), tolerance_(tolerance) {
@@ -85,21 +90,6 @@ class IntervalRmseSink final : public Component, public RunResultCodec {
     if (single)  // measurements carry no target id: only a single truth target can score them
       for (const auto& m : measurements_)
         if (m.time >= from) score(m, metrics::truth_for(truth_, 0), *r, false);
-    return r;
-  }
-
-  // Per-run bins cross processes under mpirun (run_result_codec.hpp).
-  void save_run_result(const RunResult& result, ByteWriter& out) const override {
-    const auto& r = static_cast<const IntervalRunResult&>(result);
-    out.put_vector(r.bins);
-    out.put(r.non_finite);
-    out.put(r.unmatched);
-  }
-  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override {
-    auto r = std::make_unique<IntervalRunResult>();
-    in.get_vector(r->bins);
-    in.get(r->non_finite);
-    in.get(r->unmatched);
     return r;
   }
 

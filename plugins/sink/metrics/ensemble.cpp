@@ -12,66 +12,6 @@
 
 namespace trackflow::metrics {
 
-void save(const MetricsRunResult& r, ByteWriter& out) {
-  out.put(static_cast<std::uint64_t>(r.records.size()));
-  for (const EstimateRecord& e : r.records) {
-    out.put(e.key);
-    out.put(e.time);
-    out.put(e.initialised);
-    out.put(e.updated);
-    out.put(e.scored);
-    out.put(e.annotation);
-    out.put(e.matched);
-    out.put(e.has_nees);
-    out.put_matrix(e.error);
-    out.put(e.nees);
-    out.put(e.nees_position);
-    out.put(e.nis_dof);
-    out.put(e.nis);
-    out.put_matrix(e.innovation);
-  }
-  out.put_vector(r.measurement_records);
-  out.put(r.had_truth);
-  out.put(r.before_window);
-  out.put(r.non_finite);
-  out.put(r.unmatched);
-  out.put(r.not_positive_definite);
-  out.put(r.measurement_sq_error);
-  out.put(r.measurements_matched);
-  out.put(r.measurements_unmatched);
-}
-
-std::unique_ptr<MetricsRunResult> load(ByteReader& in) {
-  auto r = std::make_unique<MetricsRunResult>();
-  r->records.resize(in.get<std::uint64_t>());
-  for (EstimateRecord& e : r->records) {
-    in.get(e.key);
-    in.get(e.time);
-    in.get(e.initialised);
-    in.get(e.updated);
-    in.get(e.scored);
-    in.get(e.annotation);
-    in.get(e.matched);
-    in.get(e.has_nees);
-    in.get_matrix(e.error);
-    in.get(e.nees);
-    in.get(e.nees_position);
-    in.get(e.nis_dof);
-    in.get(e.nis);
-    in.get_matrix(e.innovation);
-  }
-  in.get_vector(r->measurement_records);
-  in.get(r->had_truth);
-  in.get(r->before_window);
-  in.get(r->non_finite);
-  in.get(r->unmatched);
-  in.get(r->not_positive_definite);
-  in.get(r->measurement_sq_error);
-  in.get(r->measurements_matched);
-  in.get(r->measurements_unmatched);
-  return r;
-}
-
 namespace {
 
 constexpr std::size_t kNoStep = static_cast<std::size_t>(-1);

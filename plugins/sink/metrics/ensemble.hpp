@@ -29,6 +29,11 @@ struct EstimateRecord {
   int nis_dof = 0;          // innovation dimension; 0 when the estimate was not updated
   double nis = 0.0;
   InnovationVec innovation = InnovationVec::Zero();
+  template <class Self, class F>
+  static void fields(Self& e, F&& f) {
+    f(e.key, e.time, e.initialised, e.updated, e.scored, e.annotation, e.matched, e.has_nees, e.error, e.nees,
+      e.nees_position, e.nis_dof, e.nis, e.innovation);
+  }
 };
 
 // A valid measurement of one run matched to truth (for the per-step measurement RMSE).
@@ -49,11 +54,14 @@ struct MetricsRunResult final : RunResult {
   // Measurement baseline of this run (a sum over one run is fixed by the run's own item order).
   double measurement_sq_error = 0.0;
   std::uint64_t measurements_matched = 0, measurements_unmatched = 0;
+  // A run's records as bytes and back, exactly (mpirun: run_result_codec.hpp's FieldListCodec);
+  // the estimate records go one by one with their own list, the measurement records as one block.
+  template <class Self, class F>
+  static void fields(Self& r, F&& f) {
+    f(r.records, r.measurement_records, r.had_truth, r.before_window, r.non_finite, r.unmatched,
+      r.not_positive_definite, r.measurement_sq_error, r.measurements_matched, r.measurements_unmatched);
+  }
 };
-
-// A run's records as bytes and back, exactly (mpirun: run_result_codec.hpp).
-void save(const MetricsRunResult& r, ByteWriter& out);
-std::unique_ptr<MetricsRunResult> load(ByteReader& in);
 
 struct StepSums {
   double time = 0.0;  // of the first run that reached this step

@@ -26,7 +26,8 @@ enum class SameTime { All, Last };
 
 // Items are only stored during a run; everything is evaluated in end_run(), when the truth of
 // the whole run is known (truth of a time step may arrive after the estimate of that step).
-class MetricsSink final : public Component, public RunResultCodec {
+// Per-run records cross processes under mpirun by MetricsRunResult's field list (ensemble.hpp).
+class MetricsSink final : public Component, public FieldListCodec<MetricsRunResult> {
  public:
   explicit MetricsSink(const Params& p)
       : skip_initial_(p.real("skip_initial")),
@@ -135,12 +136,6 @@ class MetricsSink final : public Component, public RunResultCodec {
   }
 
   void merge(RunResult& result) override { ensemble_.add(static_cast<MetricsRunResult&>(result)); }
-
-  // Per-run records cross processes under mpirun (run_result_codec.hpp; ensemble.hpp).
-  void save_run_result(const RunResult& result, ByteWriter& out) const override {
-    metrics::save(static_cast<const MetricsRunResult&>(result), out);
-  }
-  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override { return metrics::load(in); }
 
   void finish(Summary& summary, const FinishContext&) override {
     const metrics::ReportOptions opt{confidence_, skip_initial_, truth_input_, measurement_input_};

@@ -16,10 +16,15 @@ struct SwitchRunResult final : RunResult {
   bool switched = false;   // false: `steps` counts all estimates after `after` (a lower bound)
   double before_sum = 0.0; // annotation values in [after - before, after)
   std::uint64_t before_n = 0;
+  // Its codec under mpirun (run_result_codec.hpp): one list, written and read in this order.
+  template <class Self, class F>
+  static void fields(Self& r, F&& f) {
+    f(r.steps, r.switched, r.before_sum, r.before_n);
+  }
 };
 
 // Streams: each estimate is looked at once, in arrival (time) order; nothing is stored.
-class ModeSwitchSink final : public Component, public RunResultCodec {
+class ModeSwitchSink final : public Component, public FieldListCodec<SwitchRunResult> {
  public:
   ModeSwitchSink(std::string annotation, double after, double before, double threshold, SourceLoc where)
       : annotation_(std::move(annotation)), after_(after), before_(before), threshold_(threshold),
@@ -62,22 +67,6 @@ class ModeSwitchSink final : public Component, public RunResultCodec {
   }
 
   std::unique_ptr<RunResult> end_run() override { return std::make_unique<SwitchRunResult>(run_); }
-
-  void save_run_result(const RunResult& result, ByteWriter& out) const override {
-    const auto& r = static_cast<const SwitchRunResult&>(result);
-    out.put(r.steps);
-    out.put(r.switched);
-    out.put(r.before_sum);
-    out.put(r.before_n);
-  }
-  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override {
-    auto r = std::make_unique<SwitchRunResult>();
-    in.get(r->steps);
-    in.get(r->switched);
-    in.get(r->before_sum);
-    in.get(r->before_n);
-    return r;
-  }
 
   void merge(RunResult& result) override {
     const auto& r = static_cast<const SwitchRunResult&>(result);

@@ -16,10 +16,15 @@ namespace {
 struct RecoveryRunResult final : RunResult {
   recovery::RunStats stats;
   std::uint64_t non_finite = 0, unmatched = 0, samples = 0;
+  // Its codec under mpirun (run_result_codec.hpp): one list, written and read in this order.
+  template <class Self, class F>
+  static void fields(Self& r, F&& f) {
+    f(r.stats.bursts, r.stats.sq_error, r.stats.count, r.non_finite, r.unmatched, r.samples);
+  }
 };
 
 // Estimates are stored during the run and judged in end_run(), when all truth has arrived.
-class RecoverySink final : public Component, public RunResultCodec {
+class RecoverySink final : public Component, public FieldListCodec<RecoveryRunResult> {
  public:
   RecoverySink(const recovery::Settings& s, double skip_initial, double tolerance)
       : s_(s), skip_initial_(skip_initial), tolerance_(tolerance) {
@@ -73,27 +78,6 @@ class RecoverySink final : public Component, public RunResultCodec {
     }
     r->samples = samples_.size();
     r->stats = recovery::evaluate(samples_, s_);
-    return r;
-  }
-
-  // Per-run statistics cross processes under mpirun (run_result_codec.hpp).
-  void save_run_result(const RunResult& result, ByteWriter& out) const override {
-    const auto& r = static_cast<const RecoveryRunResult&>(result);
-    out.put_vector(r.stats.bursts);
-    out.put(r.stats.sq_error);
-    out.put(r.stats.count);
-    out.put(r.non_finite);
-    out.put(r.unmatched);
-    out.put(r.samples);
-  }
-  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override {
-    auto r = std::make_unique<RecoveryRunResult>();
-    in.get_vector(r->stats.bursts);
-    in.get(r->stats.sq_error);
-    in.get(r->stats.count);
-    in.get(r->non_finite);
-    in.get(r->unmatched);
-    in.get(r->samples);
     return r;
   }
 

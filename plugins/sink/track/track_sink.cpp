@@ -26,16 +26,25 @@ struct Point {
 struct Stream {
   ItemKind kind;
   std::vector<Point> points;
+  template <class Self, class F>
+  static void fields(Self& s, F&& f) {
+    f(s.kind, s.points);
+  }
 };
 
 struct TrackRunResult final : RunResult {
   std::vector<Stream> streams;  // by input port x kind, as laid out in set_inputs
+  // Its codec under mpirun (run_result_codec.hpp): one list, written and read in this order.
+  template <class Self, class F>
+  static void fields(Self& r, F&& f) {
+    f(r.streams);
+  }
 };
 
 // Records only run `run`; every other run costs one comparison per item. Buffers are sized at
 // the start of the recorded run, so recording does not allocate per item for runs of up to
 // kReserve items per stream.
-class TrackSink final : public Component, public RunResultCodec {
+class TrackSink final : public Component, public FieldListCodec<TrackRunResult> {
  public:
   explicit TrackSink(const Params& p) : run_(static_cast<std::uint64_t>(p.integer("run"))) {}
 
@@ -102,25 +111,6 @@ class TrackSink final : public Component, public RunResultCodec {
     active_ = false;
     auto r = std::make_unique<TrackRunResult>();
     r->streams = streams_;
-    return r;
-  }
-
-  // The recorded run crosses processes under mpirun (run_result_codec.hpp).
-  void save_run_result(const RunResult& result, ByteWriter& out) const override {
-    const auto& r = static_cast<const TrackRunResult&>(result);
-    out.put(static_cast<std::uint64_t>(r.streams.size()));
-    for (const auto& s : r.streams) {
-      out.put(s.kind);
-      out.put_vector(s.points);
-    }
-  }
-  std::unique_ptr<RunResult> load_run_result(ByteReader& in) const override {
-    auto r = std::make_unique<TrackRunResult>();
-    r->streams.resize(in.get<std::uint64_t>());
-    for (auto& s : r->streams) {
-      in.get(s.kind);
-      in.get_vector(s.points);
-    }
     return r;
   }
 
