@@ -18,7 +18,6 @@
 #include <queue>
 #include <system_error>
 #include <thread>
-#include <unordered_map>
 
 namespace trackflow::host {
 namespace {
@@ -71,9 +70,6 @@ Outcome run_graph(const Graph& g, const PluginRegistry& registry, const RunOptio
   for (const auto& n : g.nodes)
     if (n.type->decl.kind == ComponentKind::Filter) ++out.filters;
 
-  std::unordered_map<std::string, std::size_t> node_index;
-  for (size_t i = 0; i < N; ++i) node_index.emplace(out.nodes[i].id, i);
-
   // The aggregating instance is built first so construction errors surface before any thread starts.
   GraphInstance aggregate = instantiate(g, registry);
   const NodeLabels aggregate_labels = labels_of(g, aggregate);
@@ -97,8 +93,6 @@ Outcome run_graph(const Graph& g, const PluginRegistry& registry, const RunOptio
     merging.has_run = true;
     ActivityScope scope(merging);
     try {
-      out.source_items += rec.source_items;
-      out.measurements_processed += rec.measurements_processed;
       for (size_t i = 0; i < N; ++i)
         if (rec.results[i]) {
           detail::executing = aggregate.components[i].get();
@@ -107,16 +101,7 @@ Outcome run_graph(const Graph& g, const PluginRegistry& registry, const RunOptio
     } catch (...) {
       rethrow_from_plugin();
     }
-    for (const auto& s : rec.diagnostics.skips) {
-      const auto it = node_index.find(s.node);
-      if (it == node_index.end()) continue;
-      auto& n = out.nodes[it->second];
-      ++n.skips;
-      if (n.skip_examples.size() < 5)
-        n.skip_examples.push_back((runs > 1 ? "run " + std::to_string(r) + ": " : "") + s.message);
-    }
-    for (const auto& w : rec.diagnostics.warnings)
-      if (out.warnings.size() < 20) out.warnings.push_back(w.node + ": " + w.message);
+    merge_run_diagnostics(rec, r, runs, out);
   };
   auto complete = [&](std::uint64_t run, RunRecord&& rec) {
     std::lock_guard<std::mutex> lock(merge_mutex);

@@ -340,20 +340,9 @@ Outcome root_rank(const Graph& g, const PluginRegistry& registry, const RunOptio
   std::uint64_t next_merge = 0;
   std::mutex merge_mutex;
   auto merge_one = [&](std::uint64_t r, RunRecord& rec) {
-    out.source_items += rec.source_items;
-    out.measurements_processed += rec.measurements_processed;
     for (size_t i = 0; i < N; ++i)
       if (rec.results[i]) aggregate.components[i]->merge(*rec.results[i]);
-    for (const auto& s : rec.diagnostics.skips) {
-      for (auto& n : out.nodes) {
-        if (n.id != s.node) continue;
-        ++n.skips;
-        if (n.skip_examples.size() < 5)
-          n.skip_examples.push_back((runs > 1 ? "run " + std::to_string(r) + ": " : "") + s.message);
-      }
-    }
-    for (const auto& w : rec.diagnostics.warnings)
-      if (out.warnings.size() < 20) out.warnings.push_back(w.node + ": " + w.message);
+    merge_run_diagnostics(rec, r, runs, out);
   };
   auto complete = [&](std::uint64_t run, RunRecord&& rec) {
     std::lock_guard<std::mutex> lock(merge_mutex);

@@ -7,6 +7,7 @@
 #include <functional>
 #include <limits>
 #include <queue>
+#include <string>
 #include <utility>
 
 namespace trackflow::host {
@@ -100,6 +101,21 @@ RunRecord run_one(const Graph& g, GraphInstance& inst, const std::vector<Filter*
   }
   detail::executing = nullptr;
   return rec;
+}
+
+void merge_run_diagnostics(const RunRecord& rec, std::uint64_t run, std::uint64_t runs, Outcome& out) {
+  out.source_items += rec.source_items;
+  out.measurements_processed += rec.measurements_processed;
+  for (const auto& s : rec.diagnostics.skips) {
+    for (auto& n : out.nodes) {
+      if (n.id != s.node) continue;
+      ++n.skips;
+      if (n.skip_examples.size() < 5)
+        n.skip_examples.push_back((runs > 1 ? "run " + std::to_string(run) + ": " : "") + s.message);
+    }
+  }
+  for (const auto& w : rec.diagnostics.warnings)
+    if (out.warnings.size() < 20) out.warnings.push_back(w.node + ": " + w.message);
 }
 
 }  // namespace trackflow::host

@@ -1,7 +1,8 @@
-// Purpose: one Monte Carlo run on one graph instance — the engine's and the MPI engine's shared step: resets, start_run, the time-ordered merge of the sources, end_run.
+// Purpose: one Monte Carlo run on one graph instance — the engine's and the MPI engine's shared step: resets, start_run, the time-ordered merge of the sources, end_run — and the merge of its counts and diagnostics into the Outcome.
 #pragma once
 
 #include <trackflow/component.hpp>
+#include <trackflow/host/engine.hpp>
 #include <trackflow/host/graph.hpp>
 
 #include <cstdint>
@@ -27,5 +28,10 @@ std::vector<Filter*> filters_of(GraphInstance& inst);
 // handler; exceptions pass through (callers name the run and the plugin).
 RunRecord run_one(const Graph& g, GraphInstance& inst, const std::vector<Filter*>& filters, std::uint64_t seed,
                   std::uint64_t run);
+
+// The ordered reduction's bookkeeping for run `run` of `runs`: its item counts, and its diagnostics
+// as the report shows them (a skip count per node with at most 5 examples, each prefixed with its
+// run when there is more than one; at most 20 warnings in all). Call in run order.
+void merge_run_diagnostics(const RunRecord& rec, std::uint64_t run, std::uint64_t runs, Outcome& out);
 
 }  // namespace trackflow::host

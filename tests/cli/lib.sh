@@ -32,11 +32,12 @@ finish() {
   echo "$checks passed, 0 failed"
 }
 
-# base_pipeline NAME RUNS: a valid pipeline (5 s at 10 Hz through sim.radar, convert.classical,
-# filter.kalman and sink.metrics) that a test copies and breaks one thing in.
-base_pipeline() {
+# truth_radar NAME RUNS SEED SECONDS: the head of a pipeline, a constant-velocity truth at 10 Hz for
+# SECONDS into sim.radar (its last line is the radar's `input:`, so a caller may add its params);
+# a test appends the nodes it is about.
+truth_radar() {
   cat <<YAML
-pipeline: { name: $1, seed: 1, runs: $2 }
+pipeline: { name: $1, seed: $3, runs: $2 }
 nodes:
   - id: truth
     type: sim.trajectory
@@ -44,17 +45,33 @@ nodes:
       rate: 10 Hz
       initial_position: [6000, 8000, 1000]
       initial_velocity: [-150, 50, 0]
-      segments: [ { type: constant_velocity, duration: 5 s } ]
+      segments: [ { type: constant_velocity, duration: $4 s } ]
   - id: radar
     type: sim.radar
     input: truth
-    params: { sigma_range: 10 m }
+YAML
+}
+
+# classical_kalman: the radar's measurements through convert.classical (node cm) into filter.kalman
+# (node kf), to append after truth_radar; its last line is kf's `input:`, so a caller may add kf's params.
+classical_kalman() {
+  cat <<YAML
   - id: cm
     type: convert.classical
     input: radar
   - id: kf
     type: filter.kalman
     input: cm
+YAML
+}
+
+# base_pipeline NAME RUNS: a valid pipeline (5 s at 10 Hz through sim.radar, convert.classical,
+# filter.kalman and sink.metrics) that a test copies and breaks one thing in.
+base_pipeline() {
+  truth_radar "$1" "$2" 1 5
+  echo "    params: { sigma_range: 10 m }"
+  classical_kalman
+  cat <<YAML
   - id: score
     type: sink.metrics
     inputs: [kf, truth]

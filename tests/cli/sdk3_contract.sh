@@ -6,22 +6,7 @@ PLUGINS=$2
 TEST_PLUGINS="$PLUGINS/../test-plugins"
 source "$(dirname "$0")/lib.sh"
 
-radar_nodes() {
-  cat <<'YAML'
-pipeline: { name: contract, seed: 3, runs: 4 }
-nodes:
-  - id: truth
-    type: sim.trajectory
-    params:
-      rate: 10 Hz
-      initial_position: [6000, 8000, 1000]
-      initial_velocity: [-150, 50, 0]
-      segments: [ { type: constant_velocity, duration: 20 s } ]
-  - id: radar
-    type: sim.radar
-    input: truth
-YAML
-}
+radar_nodes() { truth_radar contract 4 3 20; }
 
 # 1. A spherical radar wired straight into a Cartesian-only filter.
 { radar_nodes; cat <<'YAML'
@@ -127,13 +112,7 @@ done
 # 4. The engine restores adapted process noise at every run: test.q_ramp doubles q at every step
 # and publishes the q it found; filter.kalman does not restore q itself. Every run's first
 # estimate must see the configured q (2), and the output must not depend on the thread count.
-{ radar_nodes; cat <<'YAML'
-  - id: cm
-    type: convert.classical
-    input: radar
-  - id: kf
-    type: filter.kalman
-    input: cm
+{ radar_nodes; classical_kalman; cat <<'YAML'
     params: { q: 2 m2/s3, init: explicit, initial_position: [6000, 8000, 1000], initial_sigma_position: 100 m,
               initial_sigma_velocity: 200 m/s }   # initialised from the first measurement on
   - id: ramp

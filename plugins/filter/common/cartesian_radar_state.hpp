@@ -4,6 +4,7 @@
 #include "cartesian_filter_settings.hpp"
 #include "three_point_init.hpp"
 
+#include <trackflow/estimate_state.hpp>
 #include <trackflow/geometry.hpp>
 #include <trackflow/items.hpp>
 #include <trackflow/motion.hpp>
@@ -204,16 +205,7 @@ class CartesianRadarState {
     }
   }
 
-  void fill_state(Estimate& e) const {
-    e.state.resize(N);
-    e.state.template head<N>() = x_;
-    e.covariance.resize(N, N);
-    e.covariance.template topLeftCorner<N, N>() = P_;
-    for (int i = 0; i < 6; ++i) {
-      e.enu(i) = x_(idx_[i]);
-      for (int j = 0; j < 6; ++j) e.enu_covariance(i, j) = P_(idx_[i], idx_[j]);
-    }
-  }
+  void fill_state(Estimate& e) const { set_estimate_state(e, x_, P_, idx_); }
 
   Settings s_;
   double q_[3] = {};  // process-noise intensity per ENU axis (adapters may retune it)

@@ -1,6 +1,7 @@
 // Purpose: filter.decoupled — paper 001's decoupled CV Kalman filter on converted Cartesian position measurements.
 #include "decoupled_cv.hpp"
 
+#include <trackflow/estimate_state.hpp>
 #include <trackflow/filter_front_end.hpp>
 #include <trackflow/motion.hpp>
 #include <trackflow/plugin.hpp>
@@ -118,14 +119,7 @@ class DecoupledFilter final : public FilterFrontEnd<DecoupledFilter> {
 
   void fill_estimate(Estimate& e) {
     f_.cartesian_covariance(P_);
-    e.state.resize(6);
-    e.state.head<6>() = f_.x;
-    e.covariance.resize(6, 6);
-    e.covariance.topLeftCorner<6, 6>() = P_;
-    for (int i = 0; i < 6; ++i) {
-      e.enu(i) = f_.x(idx_[i]);
-      for (int j = 0; j < 6; ++j) e.enu_covariance(i, j) = P_(idx_[i], idx_[j]);
-    }
+    set_estimate_state(e, f_.x, P_, idx_);
   }
 
   DecoupledSettings s_;

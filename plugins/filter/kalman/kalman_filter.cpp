@@ -1,4 +1,5 @@
 // Purpose: filter.kalman — linear Kalman filter on Cartesian position measurements with CV or CA motion.
+#include <trackflow/estimate_state.hpp>
 #include <trackflow/filter_front_end.hpp>
 #include <trackflow/kalman.hpp>
 #include <trackflow/motion.hpp>
@@ -196,16 +197,7 @@ class KalmanFilter final : public FilterFrontEnd<KalmanFilter<Model>> {
     return true;
   }
 
-  void fill_estimate(Estimate& e) const {
-    e.state.resize(N);
-    e.state.template head<N>() = x_;
-    e.covariance.resize(N, N);
-    e.covariance.template topLeftCorner<N, N>() = P_;
-    for (int i = 0; i < 6; ++i) {
-      e.enu(i) = x_(idx_[i]);
-      for (int j = 0; j < 6; ++j) e.enu_covariance(i, j) = P_(idx_[i], idx_[j]);
-    }
-  }
+  void fill_estimate(Estimate& e) const { set_estimate_state(e, x_, P_, idx_); }
 
   KalmanSettings s_;
   StateN x_ = StateN::Zero();

@@ -2,6 +2,7 @@
 #include "fusion_math.hpp"
 
 #include <trackflow/error.hpp>
+#include <trackflow/estimate_state.hpp>
 #include <trackflow/motion.hpp>
 #include <trackflow/plugin.hpp>
 #include <trackflow/run_result_codec.hpp>
@@ -231,14 +232,7 @@ class TrackFusion final : public Component, public FieldListCodec<FusionRunResul
       return;
     }
     est_.initialised = true;
-    est_.state.resize(N);
-    est_.state.template head<N>() = xf_;
-    est_.covariance.resize(N, N);
-    est_.covariance.template topLeftCorner<N, N>() = Pf_;
-    for (int i = 0; i < 6; ++i) {
-      est_.enu(i) = xf_(idx_[i]);
-      for (int j = 0; j < 6; ++j) est_.enu_covariance(i, j) = Pf_(idx_[i], idx_[j]);
-    }
+    set_estimate_state(est_, xf_, Pf_, idx_);
     ++run_.fused;
     out.emit(est_);
   }

@@ -3,7 +3,6 @@
 
 #include <GeographicLib/Geodesic.hpp>
 
-#include <algorithm>
 #include <memory>
 #include <string>
 
@@ -52,20 +51,7 @@ std::vector<MotionPiece> build_geodetic_launch_plan(const Params& params) {
   piece.motion = Motion::GeodeticLaunch;
   piece.geodetic_launch = std::make_shared<const GeodeticLaunchPath>(kslv1_table(), pad.where,
                                                                      params.real("launch_azimuth"), frame);
-  double duration = piece.geodetic_launch->duration();
-  if (params.has("profile_duration")) {
-    const double wanted = params.real("profile_duration");
-    if (wanted > duration + 1e-9)
-      throw params.error("profile_duration", "is longer than the " + profile + " table (" +
-                                                 std::to_string(static_cast<int>(duration)) + " s)");
-    duration = std::min(wanted, duration);
-  }
-  piece.start = params.real("start_time");
-  piece.end = piece.start + duration;
-  const Kinematics k0 = piece.geodetic_launch->at(0.0);
-  piece.position = k0.position;
-  piece.velocity = k0.velocity;
-  piece.acceleration = k0.acceleration;
+  time_launch_piece(params, profile, piece.geodetic_launch->duration(), piece.geodetic_launch->at(0.0), piece);
   return {piece};
 }
 

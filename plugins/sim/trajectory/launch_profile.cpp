@@ -72,6 +72,23 @@ void refuse_launch_params(const Params& params) {
     if (params.given(name)) throw params.error(name, "applies to a launch profile only; add 'profile: kslv1' or remove it");
 }
 
+void time_launch_piece(const Params& params, const std::string& profile, double table_duration,
+                       const Kinematics& initial, MotionPiece& piece) {
+  double duration = table_duration;
+  if (params.has("profile_duration")) {
+    const double wanted = params.real("profile_duration");
+    if (wanted > duration + 1e-9)
+      throw params.error("profile_duration", "is longer than the " + profile + " table (" +
+                                                 std::to_string(static_cast<int>(duration)) + " s)");
+    duration = std::min(wanted, duration);
+  }
+  piece.start = params.real("start_time");
+  piece.end = piece.start + duration;
+  piece.position = initial.position;
+  piece.velocity = initial.velocity;
+  piece.acceleration = initial.acceleration;
+}
+
 std::vector<MotionPiece> build_launch_plan(const Params& params) {
   const std::string& profile = params.choice_word("profile");
   for (const char* name : {"segments", "initial_position", "initial_velocity"})
@@ -91,20 +108,7 @@ std::vector<MotionPiece> build_launch_plan(const Params& params) {
   } catch (const std::invalid_argument& e) {
     throw params.error("launch_azimuth", e.what());
   }
-  double duration = piece.launch->duration();
-  if (params.has("profile_duration")) {
-    const double wanted = params.real("profile_duration");
-    if (wanted > duration + 1e-9)
-      throw params.error("profile_duration", "is longer than the " + profile + " table (" +
-                                                 std::to_string(static_cast<int>(duration)) + " s)");
-    duration = std::min(wanted, duration);
-  }
-  piece.start = params.real("start_time");
-  piece.end = piece.start + duration;
-  const Kinematics k0 = piece.launch->at(0.0);
-  piece.position = k0.position;
-  piece.velocity = k0.velocity;
-  piece.acceleration = k0.acceleration;
+  time_launch_piece(params, profile, piece.launch->duration(), piece.launch->at(0.0), piece);
   return {piece};
 }
 

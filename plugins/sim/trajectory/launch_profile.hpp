@@ -6,6 +6,7 @@
 
 #include <trackflow/params.hpp>
 
+#include <string>
 #include <vector>
 
 namespace trackflow::sim {
@@ -54,6 +55,12 @@ class LaunchPath {
   Vec3 centre_ = Vec3::Zero(), up_ = Vec3::UnitZ(), along_ = Vec3::UnitY();
   double pad_radius_ = 0.0;
 };
+
+// What a launch piece (flat, spherical or geodetic placement) takes from its path: start_time,
+// the end after the table's duration or the shorter profile_duration (refused if longer), and the
+// kinematics at lift-off (`initial`, the path at tau = 0).
+void time_launch_piece(const Params& params, const std::string& profile, double table_duration,
+                       const Kinematics& initial, MotionPiece& piece);
 
 // The pieces for `profile: kslv1`: one launch piece from start_time over the table (or
 // profile_duration). Validates that no segment-mode parameter is given and the launch ones are.

@@ -6,7 +6,7 @@
 #include <GeographicLib/Geodesic.hpp>
 #include <catch2/catch.hpp>
 
-#include "plugin_fixture.hpp"
+#include "trajectory_test_support.hpp"
 
 #include <cmath>
 #include <numbers>
@@ -27,22 +27,8 @@ const std::string kSites =
     "frame_origin: jeju\n";
 const std::string kLaunch = kSites + "profile: kslv1\nearth: wgs84\npad_site: naro\nlaunch_azimuth: 170 deg\n";
 
-std::vector<Truth> fly(const std::string& yaml) {
-  auto gen = test::make("sim.trajectory", yaml);
-  test::Collector out;
-  out.attach_to(*gen);
-  test::drain(*gen);
-  return out.truths;
-}
-
-std::string config_error(const std::string& yaml) {
-  try {
-    (void)test::make("sim.trajectory", yaml);
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return {};
-}
+using test::config_error;
+using test::fly;
 
 }  // namespace
 

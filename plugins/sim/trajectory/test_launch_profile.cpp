@@ -5,7 +5,7 @@
 #include <Eigen/Geometry>
 #include <catch2/catch.hpp>
 
-#include "plugin_fixture.hpp"
+#include "trajectory_test_support.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -22,22 +22,8 @@ constexpr double kDeg = std::numbers::pi / 180;
 const double kTable16[][3] = {{0, 0.1, 0},     {0.2, 0.1, 0},   {54, 7.2, 0.8},     {215, 177, 245},    {229, 193, 303},
                               {232, 196, 316}, {395, 303, 1052}, {453, 304, 1390}, {540, 302, 2054}};
 
-std::vector<Truth> fly(const std::string& yaml) {
-  auto gen = test::make("sim.trajectory", yaml);
-  test::Collector out;
-  out.attach_to(*gen);
-  test::drain(*gen);
-  return out.truths;
-}
-
-std::string config_error(const std::string& yaml) {
-  try {
-    (void)test::make("sim.trajectory", yaml);
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return {};
-}
+using test::config_error;
+using test::fly;
 
 sim::LaunchPath path(const Vec3& pad, double azimuth_deg, bool spherical) {
   return sim::LaunchPath(sim::kslv1_table(), {pad, azimuth_deg * kDeg, spherical});

@@ -4,6 +4,7 @@
 #include "flight_plan.hpp"
 #include "launch_profile.hpp"
 #include "plugin_fixture.hpp"
+#include "trajectory_test_support.hpp"
 
 #include <trackflow/rng.hpp>
 
@@ -17,28 +18,13 @@ using namespace trackflow;
 
 namespace {
 
-std::vector<Truth> fly(const std::string& yaml, std::uint64_t seed = 1, std::uint64_t run = 0) {
-  auto gen = test::make("sim.trajectory", yaml);
-  test::Collector out;
-  out.attach_to(*gen);
-  test::drain(*gen, seed, run);
-  return out.truths;
-}
+using test::config_error;
+using test::fly;
 
 std::string num(double v) {
   char buf[64];
   std::snprintf(buf, sizeof buf, "%.17g", v);
   return buf;
-}
-
-// The message of the ConfigError that building `yaml` throws ("" if none).
-std::string config_error(const std::string& yaml) {
-  try {
-    (void)test::make("sim.trajectory", yaml);
-  } catch (const ConfigError& e) {
-    return e.what();
-  }
-  return {};
 }
 
 // Reference turn: RK4 on dp/dt = v, dv/dt = w z^ x v with a small step, independent of the plugin's closed form.
@@ -328,6 +314,31 @@ sim::Kinematics profile_at(const std::vector<sim::MotionPiece>& pieces, double t
   return sim::evaluate(pieces[i], t);
 }
 
+// The set-up of the process-noise moment tests: a straight CV flight sampled every T, R runs with
+// the per-axis intensities q (the "[4, 1, 0.25]" the tests append to `base`), compared with the
+// noise-free `profile` over its K steps.
+struct NoiseExperiment {
+  Vec3 q = Vec3(4.0, 1.0, 0.25);
+  double T = 0.1;
+  int R = 400;
+  std::string base = "rate: 10 Hz\ninitial_position: [1 m, 2 m, 3 m]\ninitial_velocity: [5 m/s, -5 m/s, 0]\n"
+                     "segments: [{type: constant_velocity, duration: 10 s}]\n";
+  std::vector<Truth> profile = fly(base);
+  int K = static_cast<int>(profile.size()) - 1;
+};
+
+// The moment estimate S of the covariance E from n independent vectors, entry by entry within 5 sd,
+// Var S_ij = (E_ii E_jj + E_ij²) / n (Isserlis).
+template <int D>
+void check_covariance(const Eigen::Matrix<double, D, D>& S, const Eigen::Matrix<double, D, D>& E, double n) {
+  for (int i = 0; i < D; ++i)
+    for (int j = i; j < D; ++j) {
+      const double sd = std::sqrt((E(i, i) * E(j, j) + E(i, j) * E(i, j)) / n);
+      INFO("entry " << i << " " << j << ": " << S(i, j) << " expected " << E(i, j) << " sd " << sd);
+      CHECK(std::abs(S(i, j) - E(i, j)) < 5 * sd);
+    }
+}
+
 }  // namespace
 
 TEST_CASE("process noise off: output is the deterministic profile") {
@@ -365,13 +376,8 @@ TEST_CASE("process noise increments have the CV model covariance") {
   // |S_ij - Σ_ij| < 5 sd has a false-alarm chance below 1e-6 per entry (the seed is fixed, so the
   // test is deterministic; the bound is what makes a wrong factor such as T² or T³/2 fail:
   // those are off by 25 % or more, against 5 sd = 5 √(2/N) = 3.5 % on a diagonal entry).
-  const Vec3 q(4.0, 1.0, 0.25);
-  const double T = 0.1;
-  const int R = 400;
-  const std::string base = "rate: 10 Hz\ninitial_position: [1 m, 2 m, 3 m]\ninitial_velocity: [5 m/s, -5 m/s, 0]\n"
-                           "segments: [{type: constant_velocity, duration: 10 s}]\n";
-  const auto profile = fly(base);
-  const int K = static_cast<int>(profile.size()) - 1;
+  const NoiseExperiment experiment;
+  const auto& [q, T, R, base, profile, K] = experiment;
   REQUIRE(K == 100);
   Eigen::Matrix<double, 6, 6> sum = Eigen::Matrix<double, 6, 6>::Zero();
   Eigen::Matrix<double, 6, 6> end_sum = Eigen::Matrix<double, 6, 6>::Zero();
@@ -415,17 +421,9 @@ TEST_CASE("process noise increments have the CV model covariance") {
     }
     return m;
   };
-  auto check_cov = [](const Eigen::Matrix<double, 6, 6>& S, const Eigen::Matrix<double, 6, 6>& E, double n) {
-    for (int i = 0; i < 6; ++i)
-      for (int j = i; j < 6; ++j) {
-        const double sd = std::sqrt((E(i, i) * E(j, j) + E(i, j) * E(i, j)) / n);
-        INFO("entry " << i << " " << j << ": " << S(i, j) << " expected " << E(i, j) << " sd " << sd);
-        CHECK(std::abs(S(i, j) - E(i, j)) < 5 * sd);
-      }
-  };
   const double N = static_cast<double>(R) * K;
-  check_cov(sum / N, model(T), N);
-  check_cov(end_sum / R, model(K * T), R);  // R = 400: 5 sd is 35 % on a diagonal entry
+  check_covariance<6>(sum / N, model(T), N);
+  check_covariance<6>(end_sum / R, model(K * T), R);  // R = 400: 5 sd is 35 % on a diagonal entry
 }
 
 TEST_CASE("white jerk increments have the CA model covariance") {
@@ -433,13 +431,8 @@ TEST_CASE("white jerk increments have the CA model covariance") {
   // [0, 0, 1]], w ~ N(0, q Q1), Q1 = [[T⁵/20, T⁴/8, T³/6], [T⁴/8, T³/3, T²/2], [T³/6, T²/2, T]]
   // (paper 000 eq 3.19). Moment estimates of the 9-vector w against q Q1 within 5 sd, as in the
   // white-acceleration test above (a wrong factor, e.g. T⁵/6 or T⁴/2, is off by far more).
-  const Vec3 q(4.0, 1.0, 0.25);
-  const double T = 0.1;
-  const int R = 400;
-  const std::string base = "rate: 10 Hz\ninitial_position: [1 m, 2 m, 3 m]\ninitial_velocity: [5 m/s, -5 m/s, 0]\n"
-                           "segments: [{type: constant_velocity, duration: 10 s}]\n";
-  const auto profile = fly(base);
-  const int K = static_cast<int>(profile.size()) - 1;
+  const NoiseExperiment experiment;
+  const auto& [q, T, R, base, profile, K] = experiment;
   REQUIRE(K == 100);
   using Mat9 = Eigen::Matrix<double, 9, 9>;
   using Vec9 = Eigen::Matrix<double, 9, 1>;
@@ -482,17 +475,9 @@ TEST_CASE("white jerk increments have the CA model covariance") {
         for (int j = 0; j < 3; ++j) m(3 * a + i, 3 * a + j) = q[a] * c[i][j];
     return m;
   };
-  auto check_cov = [](const Mat9& S, const Mat9& E, double n) {
-    for (int i = 0; i < 9; ++i)
-      for (int j = i; j < 9; ++j) {
-        const double sd = std::sqrt((E(i, i) * E(j, j) + E(i, j) * E(i, j)) / n);
-        INFO("entry " << i << " " << j << ": " << S(i, j) << " expected " << E(i, j) << " sd " << sd);
-        CHECK(std::abs(S(i, j) - E(i, j)) < 5 * sd);
-      }
-  };
   const double N = static_cast<double>(R) * K;
-  check_cov(sum / N, model(T), N);
-  check_cov(end_sum / R, model(K * T), R);
+  check_covariance<9>(sum / N, model(T), N);
+  check_covariance<9>(end_sum / R, model(K * T), R);
 }
 
 TEST_CASE("process noise: same seed same path - new run new path") {
