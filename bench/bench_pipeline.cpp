@@ -1,6 +1,6 @@
 // Purpose: benchmark: the quickstart pipeline against the same computation as a plain loop; one 6-state CV Kalman step through filter.kalman, as plain fixed-size Eigen, and in OpenCV's cv::KalmanFilter side by side.
 //
-// Usage: trackflow-bench [--runs N] [--reps N] [--rounds R] [--only pipeline|kalman] [--plugins DIR].
+// Usage: trackflow-bench [--runs N] [--reps N] [--rounds R] [--only pipeline|kalman|stages] [--plugins DIR].
 // Single thread.
 // Every section alternates its contenders for R rounds (default 5) and keeps each one's best
 // round, so other load on a shared machine affects them alike; rates are given per second of
@@ -8,6 +8,8 @@
 //   pipeline: quickstart through the engine and five plugins (N runs per round, default 400)
 //     against the same simulation, conversion, CV Kalman filter and error/NEES bookkeeping
 //     written as one plain loop over fixed-size Eigen (same SDK math headers).
+//   stages (only when asked): the quickstart cut after each of its five nodes against the plain
+//     loop stopped after the same work, to show what each stage costs in the framework.
 //   kalman: 1000 pre-generated Cartesian position measurements, N passes per round (default 400):
 //     filter.kalman through its plugin (virtual call, Estimate formed and read by a consumer),
 //     a plain fixed-size Eigen textbook step, and cv::KalmanFilter (OpenCV, CV_64F) with the same
@@ -52,6 +54,12 @@ namespace {
 // ANEES of the position, ANIS, measurement RMSE and the RMSE ratio. The filter is filter.kalman's
 // step written with the same SDK math (structured F P F', Joseph update from P H'). Returns the
 // number of measurements processed; adds a checksum of the outputs.
+//
+// Stage (for --only stages) stops the loop after the same work as the quickstart cut after its
+// first Stage nodes: 1 the truth, 2 the radar's noisy spherical measurement, 3 its conversion
+// (position and J R J'), 4 the Kalman step, 5 the scoring and the summary (the whole loop). What
+// a shorter loop would leave unused goes into the checksum, so the compiler cannot drop it.
+template <int Stage = 5>
 double plain_loop(int runs, double& checksum) {
   using M = ConstantVelocity;
   const double T = 0.1, q = 0.0, sr = 10.0, sa = 1e-3, se = 1e-3;
@@ -74,12 +82,24 @@ double plain_loop(int runs, double& checksum) {
       Step& st = step[k];
       const double t = k * T;
       const Vec3 p = p0 + v0 * t;
+      if constexpr (Stage == 1) {
+        st.meas_sq += p(0);
+        continue;
+      }
       const Vec3 s = enu_to_spherical(p, AzimuthConvention::NorthClockwise);
       const double r = s(0) + sr * rng.normal(), az = wrap_angle(s(1) + sa * rng.normal()), el = s(2) + se * rng.normal();
+      if constexpr (Stage == 2) {
+        st.meas_sq += r + az + el;
+        continue;
+      }
       const Vec3 z = spherical_to_enu(r, az, el, AzimuthConvention::NorthClockwise);
       const Mat3 J = spherical_to_enu_jacobian(r, az, el, AzimuthConvention::NorthClockwise);
       Mat3 R = J * Vec3(sr * sr, sa * sa, se * se).asDiagonal() * J.transpose();
       R = 0.5 * (R + R.transpose()).eval();
+      if constexpr (Stage == 3) {
+        st.meas_sq += z.sum() + R.sum();
+        continue;
+      }
       // sink.metrics scores measurements from the first estimate's time on (step 1).
       if (k > 0) st.meas_sq += (z - p).squaredNorm();
       if (k == 0) {
@@ -119,6 +139,10 @@ double plain_loop(int runs, double& checksum) {
           ++st.nis_count;
         }
       }
+      if constexpr (Stage == 4) {
+        st.meas_sq += x(0) + P(0, 0);
+        continue;
+      }
       // Error against the truth; NEES and position NEES as sink.metrics computes them (nees.hpp).
       const int idx[6] = {0, 2, 4, 1, 3, 5};
       Vec6 e;
@@ -138,6 +162,10 @@ double plain_loop(int runs, double& checksum) {
         st.nees += terms[0] + terms[1] + terms[2] + terms[3] + terms[4] + terms[5];
       }
     }
+  }
+  if constexpr (Stage < 5) {
+    for (const Step& st : step) checksum += st.meas_sq * 1e-300;
+    return static_cast<double>(runs) * steps;
   }
   // The summary's reductions.
   double sq[6] = {}, sum[6] = {}, n = 0, max_rms = 0, anees = 0, anees_position = 0, anis = 0, meas_sq = 0;
@@ -399,6 +427,55 @@ void pipeline_section(const host::PluginRegistry& reg, int runs, int rounds) {
   std::printf("(checksum %.6g)\n", checksum);
 }
 
+// The quickstart cut after each of its nodes, against the plain loop stopped after the same work:
+// what each stage adds, through the framework and as plain code. The difference of the two
+// columns is the framework's cost of that stage (its item, its checks, its call).
+void stages_section(const host::PluginRegistry& reg, int runs, int rounds) {
+  auto full = host::parse_pipeline(host::load_yaml_file(TRACKFLOW_BENCH_PIPELINE), TRACKFLOW_BENCH_PIPELINE);
+  full.expects.clear();
+  constexpr int kStages = 5;
+  std::vector<host::Graph> graphs;
+  for (int k = 1; k <= kStages; ++k) {
+    auto cut = full;
+    cut.nodes.resize(static_cast<size_t>(k));
+    graphs.push_back(host::build_graph(cut, reg));
+  }
+  host::RunOptions opt;
+  opt.runs = static_cast<std::uint64_t>(runs);
+  opt.threads = 1;
+  opt.output_dir = "/tmp/trackflow-bench-out";
+  double checksum = 0;
+  using Loop = double (*)(int, double&);
+  const Loop loops[kStages] = {&plain_loop<1>, &plain_loop<2>, &plain_loop<3>, &plain_loop<4>, &plain_loop<5>};
+  Rate pipeline[kStages], loop[kStages];
+  for (int round = 0; round < rounds; ++round)
+    for (int k = 0; k < kStages; ++k) {
+      // Per truth sample (each becomes one measurement further on).
+      double items = 0, n = 0;
+      const Clocks c = time_it([&] { items = static_cast<double>(host::run_graph(graphs[k], reg, opt).source_items); });
+      pipeline[k].add(items, c);
+      const Clocks l = time_it([&] { n = loops[k](runs, checksum); });
+      loop[k].add(n, l);
+    }
+  const char* names[kStages] = {"sim.trajectory", "+ sim.radar", "+ convert.classical", "+ filter.kalman",
+                                "+ sink.metrics (the quickstart)"};
+  std::printf("quickstart cut after each node, %d runs x 601 steps, best of %d rounds, 1 thread; ns per measurement (CPU)\n",
+              runs, rounds);
+  std::printf("%-34s %10s %10s %10s   %s\n", "pipeline up to", "pipeline", "plain", "difference", "stage: pipeline  plain  framework");
+  double prev_p = 0, prev_l = 0;
+  for (int k = 0; k < kStages; ++k) {
+    const double p = 1e9 / pipeline[k].cpu, l = 1e9 / loop[k].cpu;
+    std::printf("%-34s %10.1f %10.1f %10.1f   %13.1f %6.1f %10.1f\n", names[k], p, l, p - l, p - prev_p, l - prev_l,
+                (p - prev_p) - (l - prev_l));
+    prev_p = p;
+    prev_l = l;
+  }
+  std::printf("the 0.9 aim: the whole pipeline within %.1f ns of the plain loop (now %.1f)\n",
+              1e9 / loop[kStages - 1].cpu / 0.9 - 1e9 / loop[kStages - 1].cpu,
+              1e9 / pipeline[kStages - 1].cpu - 1e9 / loop[kStages - 1].cpu);
+  std::printf("(checksum %.6g)\n", checksum);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -414,6 +491,7 @@ int main(int argc, char** argv) {
   host::PluginRegistry reg;
   reg.load_directories({plugin_dir});
   if (only.empty() || only == "pipeline") pipeline_section(reg, runs, rounds);
+  if (only == "stages") stages_section(reg, runs, rounds);
   if (only.empty()) std::printf("\n");
   if (only.empty() || only == "kalman") kalman_section(reg, reps, rounds);
   return 0;

@@ -22,16 +22,6 @@
 namespace trackflow::host {
 namespace {
 
-NodeLabels labels_of(const Graph& g, const GraphInstance& inst) {
-  NodeLabels l;
-  for (std::size_t i = 0; i < g.nodes.size(); ++i) {
-    l.components.push_back(inst.components[i].get());
-    l.labels.push_back("node '" + g.nodes[i].config.id + "' (" + g.nodes[i].config.type + " from " +
-                       g.nodes[i].type->file + ")");
-  }
-  return l;
-}
-
 // Joins every started worker however the coordinating thread leaves (a std::thread destroyed
 // while joinable would terminate the process).
 struct Joiner {
@@ -51,7 +41,6 @@ const NodeOutcome* Outcome::find(const std::string& id) const {
 }
 
 Outcome run_graph(const Graph& g, const PluginRegistry& registry, const RunOptions& opt) {
-  const size_t N = g.nodes.size();
   const std::uint64_t runs = std::max<std::uint64_t>(1, opt.runs);
   const unsigned threads = static_cast<unsigned>(std::clamp<std::uint64_t>(opt.threads, 1, runs));
   std::atomic<std::uint64_t> next_run{0}, done{0};
@@ -59,16 +48,7 @@ Outcome run_graph(const Graph& g, const PluginRegistry& registry, const RunOptio
   std::exception_ptr error;
   std::mutex error_mutex;
 
-  Outcome out;
-  out.runs = runs;
-  out.nodes.resize(N);
-  for (size_t i = 0; i < N; ++i) {
-    out.nodes[i].id = g.nodes[i].config.id;
-    out.nodes[i].type = g.nodes[i].config.type;
-  }
-
-  for (const auto& n : g.nodes)
-    if (n.type->decl.kind == ComponentKind::Filter) ++out.filters;
+  Outcome out = empty_outcome(g, runs);
 
   // The aggregating instance is built first so construction errors surface before any thread starts.
   GraphInstance aggregate = instantiate(g, registry);
@@ -80,42 +60,20 @@ Outcome run_graph(const Graph& g, const PluginRegistry& registry, const RunOptio
   // Finished runs wait here until every earlier run has been merged: merging happens strictly
   // in run order (so sums are identical for any thread count) and memory stays bounded by the
   // runs in flight, not the ensemble size.
-  std::map<std::uint64_t, RunRecord> pending;
-  std::uint64_t next_merge = 0;
+  RunOrderMerge merger(aggregate, aggregate_labels, runs, out);
   std::mutex merge_mutex;
   // A worker does not start a run more than `window` runs ahead of the oldest unmerged one, so a
   // slow run cannot make finished ones (a sink's rows) pile up without bound.
   const std::uint64_t window = 4 * static_cast<std::uint64_t>(threads);
   std::condition_variable merged;
-  auto merge_one = [&](std::uint64_t r, RunRecord& rec) {
-    Activity merging{"merging the results of a run", &aggregate_labels};
-    merging.run = r;
-    merging.has_run = true;
-    ActivityScope scope(merging);
-    try {
-      for (size_t i = 0; i < N; ++i)
-        if (rec.results[i]) {
-          detail::executing = aggregate.components[i].get();
-          aggregate.components[i]->merge(*rec.results[i]);
-        }
-    } catch (...) {
-      rethrow_from_plugin();
-    }
-    merge_run_diagnostics(rec, r, runs, out);
-  };
   auto complete = [&](std::uint64_t run, RunRecord&& rec) {
     std::lock_guard<std::mutex> lock(merge_mutex);
-    pending.emplace(run, std::move(rec));
-    for (auto it = pending.find(next_merge); it != pending.end(); it = pending.find(next_merge)) {
-      merge_one(it->first, it->second);
-      pending.erase(it);
-      ++next_merge;
-    }
+    merger.complete(run, std::move(rec));
     merged.notify_all();
   };
   auto wait_for_window = [&](std::uint64_t run) {
     std::unique_lock<std::mutex> lock(merge_mutex);
-    merged.wait(lock, [&] { return run < next_merge + window || failed.load(); });
+    merged.wait(lock, [&] { return run < merger.merged() + window || failed.load(); });
   };
 
   auto worker = [&]() {
@@ -196,17 +154,7 @@ Outcome run_graph(const Graph& g, const PluginRegistry& registry, const RunOptio
   out.seconds = std::chrono::duration<double>(t1 - t0).count();
 
   OutputDirectoryScope dir(output_dir);
-  Activity finishing{"finishing", &aggregate_labels};
-  ActivityScope scope(finishing);
-  try {
-    for (size_t i = 0; i < N; ++i) {
-      FinishContext ctx{g.nodes[i].config.id, opt.output_dir, runs};
-      detail::executing = aggregate.components[i].get();
-      aggregate.components[i]->finish(out.nodes[i].summary, ctx);
-    }
-  } catch (...) {
-    rethrow_from_plugin();
-  }
+  finish_all(g, aggregate, aggregate_labels, opt, runs, out);
   return out;
 }
 

@@ -111,11 +111,23 @@ struct Runner {
   const RunOptions& opt;
   GraphInstance inst;
   std::vector<Filter*> filters;
+  NodeLabels labels;
   Runner(const Graph& graph, const PluginRegistry& registry, const RunOptions& o)
-      : g(graph), opt(o), inst(instantiate(graph, registry)), filters(filters_of(inst)) {}
+      : g(graph), opt(o), inst(instantiate(graph, registry)), filters(filters_of(inst)), labels(labels_of(g, inst)) {}
   RunRecord run(std::uint64_t run) {
     const size_t N = g.nodes.size();
-    RunRecord rec = run_one(g, inst, filters, opt.seed, run);
+    RunRecord rec;
+    {
+      Activity running{"running", &labels};
+      running.run = run;
+      running.has_run = true;
+      ActivityScope scope(running);
+      try {
+        rec = run_one(g, inst, filters, opt.seed, run);
+      } catch (...) {
+        rethrow_from_plugin();  // names the run, the node and its plugin file
+      }
+    }
     // Checked on every process, whichever runs the run, so the job behaves the same for any -np.
     for (size_t i = 0; i < N; ++i)
       if (rec.results[i] && !dynamic_cast<const RunResultCodec*>(inst.components[i].get()))
@@ -181,29 +193,34 @@ long long fingerprint(const Graph& g, const RunOptions& opt) {
 }
 
 // A failure of a run, as rank 0 will report it.
+// What the CLI makes of it, as the threaded engine's errors: a ConfigError exits 2 with its message
+// as it is, a DataError exits 2, an InternalError (a plugin's bug: rethrow_from_plugin) exits 3.
+enum class FailureKind : char { Config = 'C', Data = 'D', Internal = 'I' };
 struct Failure {
-  bool config = false;  // ConfigError: exit 2 with the message as it is
+  FailureKind kind = FailureKind::Data;
   std::string message;
 };
-std::string encode(const Failure& f) { return std::string(1, f.config ? 'C' : 'D') + f.message; }
-Failure decode(const std::string& s) { return {!s.empty() && s[0] == 'C', s.empty() ? s : s.substr(1)}; }
-
-Failure describe(int rank, std::uint64_t run, const std::exception& e) {
-  if (const auto* c = dynamic_cast<const ConfigError*>(&e)) return {true, c->message()};
-  return {false, "rank " + std::to_string(rank) + ": run " + std::to_string(run) + ": " + e.what()};
+std::string encode(const Failure& f) { return static_cast<char>(f.kind) + f.message; }
+Failure decode(const std::string& s) {
+  if (s.empty()) return {};
+  const char k = s[0];
+  return {k == 'C' ? FailureKind::Config : k == 'I' ? FailureKind::Internal : FailureKind::Data, s.substr(1)};
+}
+[[noreturn]] void throw_failure(const Failure& f) {
+  if (f.kind == FailureKind::Config) throw ConfigError(f.message);
+  if (f.kind == FailureKind::Internal) throw InternalError(f.message);
+  throw DataError(f.message);
 }
 
-Outcome empty_outcome(const Graph& g, std::uint64_t runs) {
-  Outcome out;
-  out.runs = runs;
-  out.nodes.resize(g.nodes.size());
-  for (size_t i = 0; i < g.nodes.size(); ++i) {
-    out.nodes[i].id = g.nodes[i].config.id;
-    out.nodes[i].type = g.nodes[i].config.type;
-  }
-  for (const auto& n : g.nodes)
-    if (n.type->decl.kind == ComponentKind::Filter) ++out.filters;
-  return out;
+// The failure of run `run` on `rank`. Errors from plugin code come through rethrow_from_plugin,
+// which names the node and already starts a DataError's message with the run.
+Failure describe(int rank, std::uint64_t run, const std::exception& e) {
+  if (const auto* c = dynamic_cast<const ConfigError*>(&e)) return {FailureKind::Config, c->message()};
+  const std::string prefix = "run " + std::to_string(run) + ": ";
+  std::string what = e.what();
+  if (what.rfind(prefix, 0) != 0) what = prefix + what;
+  const FailureKind kind = dynamic_cast<const InternalError*>(&e) ? FailureKind::Internal : FailureKind::Data;
+  return {kind, "rank " + std::to_string(rank) + ": " + what};
 }
 
 // Ranks > 0: ask for runs, run them on opt.threads threads, send the results back.
@@ -306,7 +323,6 @@ Outcome worker_rank(const Graph& g, const PluginRegistry& registry, const RunOpt
 Outcome root_rank(const Graph& g, const PluginRegistry& registry, const RunOptions& opt, mpi::communicator& world,
                   unsigned threads) {
   const MPI_Comm comm = world;
-  const size_t N = g.nodes.size();
   const std::uint64_t runs = opt.runs;
   Outcome out = empty_outcome(g, runs);
   GraphInstance aggregate = instantiate(g, registry);
@@ -335,22 +351,20 @@ Outcome root_rank(const Graph& g, const PluginRegistry& registry, const RunOptio
     return out_runs;
   };
 
-  // Merging in run order, exactly as engine.cpp does.
-  std::map<std::uint64_t, RunRecord> pending;
-  std::uint64_t next_merge = 0;
+  // Merging in run order, as engine.cpp does, whichever thread or process ran the run.
+  const NodeLabels aggregate_labels = labels_of(g, aggregate);
+  RunOrderMerge merger(aggregate, aggregate_labels, runs, out);
   std::mutex merge_mutex;
-  auto merge_one = [&](std::uint64_t r, RunRecord& rec) {
-    for (size_t i = 0; i < N; ++i)
-      if (rec.results[i]) aggregate.components[i]->merge(*rec.results[i]);
-    merge_run_diagnostics(rec, r, runs, out);
-  };
+  // A merge that fails names its node and run (rethrow_from_plugin), not the run just finished.
   auto complete = [&](std::uint64_t run, RunRecord&& rec) {
-    std::lock_guard<std::mutex> lock(merge_mutex);
-    pending.emplace(run, std::move(rec));
-    for (auto it = pending.find(next_merge); it != pending.end(); it = pending.find(next_merge)) {
-      merge_one(it->first, it->second);
-      pending.erase(it);
-      ++next_merge;
+    try {
+      std::lock_guard<std::mutex> lock(merge_mutex);
+      merger.complete(run, std::move(rec));
+    } catch (const ConfigError& e) {
+      fail({FailureKind::Config, e.message()});
+    } catch (const std::exception& e) {
+      fail({dynamic_cast<const InternalError*>(&e) ? FailureKind::Internal : FailureKind::Data,
+            std::string("rank 0: ") + e.what()});
     }
   };
 
@@ -362,14 +376,17 @@ Outcome root_rank(const Graph& g, const PluginRegistry& registry, const RunOptio
       for (;;) {
         const auto mine = take(1);
         if (mine.empty()) break;
+        RunRecord rec;
         try {
-          complete(mine[0], runner.run(mine[0]));
+          rec = runner.run(mine[0]);
         } catch (const std::exception& e) {
           fail(describe(0, mine[0], e));
+          continue;
         }
+        complete(mine[0], std::move(rec));
       }
     } catch (const std::exception& e) {
-      fail({false, std::string("rank 0: ") + e.what()});
+      fail({FailureKind::Data, std::string("rank 0: ") + e.what()});
     }
     --active;
   };
@@ -399,7 +416,7 @@ Outcome root_rank(const Graph& g, const PluginRegistry& registry, const RunOptio
               run = in.get<std::uint64_t>();
               rec = load_record(in, aggregate);  // the codecs are const: no lock needed
             } catch (const std::exception& e) {
-              fail({false, "rank " + std::to_string(src) + ": run " + std::to_string(run) + ": " + e.what()});
+              fail({FailureKind::Data, "rank " + std::to_string(src) + ": run " + std::to_string(run) + ": " + e.what()});
               break;
             }
             complete(run, std::move(rec));
@@ -422,7 +439,7 @@ Outcome root_rank(const Graph& g, const PluginRegistry& registry, const RunOptio
         std::uint64_t merged;
         {
           std::lock_guard<std::mutex> lock(merge_mutex);
-          merged = next_merge;
+          merged = merger.merged();
         }
         opt.progress(merged, runs);
         last_progress = std::chrono::steady_clock::now();
@@ -438,18 +455,12 @@ Outcome root_rank(const Graph& g, const PluginRegistry& registry, const RunOptio
   for (auto& t : pool) t.join();
   const int status = failed ? 1 : 0;
   for (int r = 1; r < world.size(); ++r) send_u64(comm, r, kFinal, static_cast<std::uint64_t>(status));
-  if (failed) {
-    if (failure.config) throw ConfigError(failure.message);
-    throw DataError(failure.message);
-  }
-  if (next_merge != runs) throw std::runtime_error("distributed run ended with " + std::to_string(next_merge) + " of " +
+  if (failed) throw_failure(failure);
+  if (merger.merged() != runs) throw std::runtime_error("distributed run ended with " + std::to_string(merger.merged()) + " of " +
                                                    std::to_string(runs) + " runs merged");
   if (opt.progress) opt.progress(runs, runs);
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  for (size_t i = 0; i < N; ++i) {
-    FinishContext ctx{g.nodes[i].config.id, opt.output_dir, runs};
-    aggregate.components[i]->finish(out.nodes[i].summary, ctx);
-  }
+  finish_all(g, aggregate, aggregate_labels, opt, runs, out);
   return out;
 }
 

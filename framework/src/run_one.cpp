@@ -70,6 +70,29 @@ std::uint64_t drive(GraphInstance& inst) {
 
 }  // namespace
 
+NodeLabels labels_of(const Graph& g, const GraphInstance& inst) {
+  NodeLabels l;
+  for (std::size_t i = 0; i < g.nodes.size(); ++i) {
+    l.components.push_back(inst.components[i].get());
+    l.labels.push_back("node '" + g.nodes[i].config.id + "' (" + g.nodes[i].config.type + " from " +
+                       g.nodes[i].type->file + ")");
+  }
+  return l;
+}
+
+Outcome empty_outcome(const Graph& g, std::uint64_t runs) {
+  Outcome out;
+  out.runs = runs;
+  out.nodes.resize(g.nodes.size());
+  for (size_t i = 0; i < g.nodes.size(); ++i) {
+    out.nodes[i].id = g.nodes[i].config.id;
+    out.nodes[i].type = g.nodes[i].config.type;
+  }
+  for (const auto& n : g.nodes)
+    if (n.type->decl.kind == ComponentKind::Filter) ++out.filters;
+  return out;
+}
+
 std::vector<Filter*> filters_of(GraphInstance& inst) {
   std::vector<Filter*> filters;
   for (auto& c : inst.components)
@@ -116,6 +139,43 @@ void merge_run_diagnostics(const RunRecord& rec, std::uint64_t run, std::uint64_
   }
   for (const auto& w : rec.diagnostics.warnings)
     if (out.warnings.size() < 20) out.warnings.push_back(w.node + ": " + w.message);
+}
+
+void RunOrderMerge::complete(std::uint64_t run, RunRecord&& rec) {
+  pending_.emplace(run, std::move(rec));
+  for (auto it = pending_.find(next_); it != pending_.end(); it = pending_.find(next_)) {
+    Activity merging{"merging the results of a run", &labels_};
+    merging.run = it->first;
+    merging.has_run = true;
+    ActivityScope scope(merging);
+    try {
+      for (size_t i = 0; i < it->second.results.size(); ++i)
+        if (it->second.results[i]) {
+          detail::executing = aggregate_.components[i].get();
+          aggregate_.components[i]->merge(*it->second.results[i]);
+        }
+    } catch (...) {
+      rethrow_from_plugin();
+    }
+    merge_run_diagnostics(it->second, it->first, runs_, out_);
+    pending_.erase(it);
+    ++next_;
+  }
+}
+
+void finish_all(const Graph& g, GraphInstance& aggregate, const NodeLabels& labels, const RunOptions& opt,
+                std::uint64_t runs, Outcome& out) {
+  Activity finishing{"finishing", &labels};
+  ActivityScope scope(finishing);
+  try {
+    for (size_t i = 0; i < g.nodes.size(); ++i) {
+      FinishContext ctx{g.nodes[i].config.id, opt.output_dir, runs};
+      detail::executing = aggregate.components[i].get();
+      aggregate.components[i]->finish(out.nodes[i].summary, ctx);
+    }
+  } catch (...) {
+    rethrow_from_plugin();
+  }
 }
 
 }  // namespace trackflow::host

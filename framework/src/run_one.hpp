@@ -4,8 +4,10 @@
 #include <trackflow/component.hpp>
 #include <trackflow/host/engine.hpp>
 #include <trackflow/host/graph.hpp>
+#include <trackflow/host/guard.hpp>
 
 #include <cstdint>
+#include <map>
 #include <memory>
 #include <vector>
 
@@ -18,6 +20,12 @@ struct RunRecord {
   std::uint64_t source_items = 0;
   std::uint64_t measurements_processed = 0;
 };
+
+// The nodes of an instance as error messages and the crash handler name them.
+NodeLabels labels_of(const Graph& g, const GraphInstance& inst);
+
+// An Outcome before any run is merged: the nodes named, the filters counted.
+Outcome empty_outcome(const Graph& g, std::uint64_t runs);
 
 // The filters of an instance (the engine resets their adapted noise before every run).
 std::vector<Filter*> filters_of(GraphInstance& inst);
@@ -33,5 +41,33 @@ RunRecord run_one(const Graph& g, GraphInstance& inst, const std::vector<Filter*
 // as the report shows them (a skip count per node with at most 5 examples, each prefixed with its
 // run when there is more than one; at most 20 warnings in all). Call in run order.
 void merge_run_diagnostics(const RunRecord& rec, std::uint64_t run, std::uint64_t runs, Outcome& out);
+
+// The ordered reduction of both engines: a finished run waits until every earlier one is merged,
+// then its per-run results go to the aggregating instance's merge() and its counts and
+// diagnostics into the Outcome -- strictly in run order, so sums are identical for any thread or
+// process count. Not thread-safe: callers hold their lock. A plugin that throws in merge() is
+// reported with its node and that run (rethrow_from_plugin); the crash handler names them too.
+class RunOrderMerge {
+ public:
+  RunOrderMerge(GraphInstance& aggregate, const NodeLabels& labels, std::uint64_t runs, Outcome& out)
+      : aggregate_(aggregate), labels_(labels), runs_(runs), out_(out) {}
+  // Adds run `run` and merges every run that is now next in order.
+  void complete(std::uint64_t run, RunRecord&& rec);
+  // How many runs are merged (the next one to merge).
+  std::uint64_t merged() const { return next_; }
+
+ private:
+  GraphInstance& aggregate_;
+  const NodeLabels& labels_;
+  const std::uint64_t runs_;
+  Outcome& out_;
+  std::map<std::uint64_t, RunRecord> pending_;
+  std::uint64_t next_ = 0;
+};
+
+// finish() of every node of the aggregating instance, on the calling thread, in graph order;
+// a plugin that throws is reported with its node (rethrow_from_plugin).
+void finish_all(const Graph& g, GraphInstance& aggregate, const NodeLabels& labels, const RunOptions& opt,
+                std::uint64_t runs, Outcome& out);
 
 }  // namespace trackflow::host

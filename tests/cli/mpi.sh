@@ -64,11 +64,21 @@ for i in 0 1 2; do same_dir "sone/sweep-$i" "sjob/sweep-$i" > /dev/null; done
 checks=$((checks + 1)); echo "ok: sweep table, CSV and per-point files identical under mpirun"
 
 # A run that fails on whichever process runs it: the job exits 2 naming the rank and the run, once.
-expect_run "a failing run stops the job, naming rank and run" 2 "data error: rank [0-2]: run 7: .*deliberate failure" -- \
+boom="node 'boom' \(test.fail_run from [^)]*\)"
+expect_run "a failing run stops the job, naming rank, run and node" 2 "data error: rank [0-2]: run 7: $boom: test.fail_run: deliberate failure" -- \
   "${MPIRUN[@]}" "$TF" run "$DATA/mpi_fail.yaml" --threads 2 --no-progress --plugin-path "$TEST_PLUGINS" --out fail
 n=$("${MPIRUN[@]}" "$TF" run "$DATA/mpi_fail.yaml" --no-progress --plugin-path "$TEST_PLUGINS" --out fail 2>&1 | grep -c "deliberate failure")
 [ "$n" -eq 1 ] || fail "the failure was printed $n times"
 checks=$((checks + 1)); echo "ok: printed once"
+# A plugin bug (a std::exception) is exit 3 as in one process; merge() runs on rank 0, in run
+# order, and a failure there names the node and the run merged, not the run that just finished.
+fail_job() { "${MPIRUN[@]}" "$TF" run "$DATA/mpi_fail.yaml" --threads 2 --no-progress --plugin-path "$TEST_PLUGINS" --out fail "$@"; }
+expect_run "a plugin bug in a run: exit 3, naming rank, run and node" 3 \
+  "internal error: rank [0-2]: run 7: $boom during run 7 threw std::logic_error: test.fail_run: deliberate bug" -- fail_job --set boom.kind=bug
+expect_run "a DataError in merge() on rank 0: exit 2, naming run and node" 2 \
+  "data error: rank 0: run 7: $boom: test.fail_run: deliberate failure" -- fail_job --set boom.during=merge
+expect_run "a plugin bug in merge() on rank 0: exit 3, naming node and run" 3 \
+  "internal error: rank 0: $boom during run 7 threw std::logic_error" -- fail_job --set boom.during=merge --set boom.kind=bug
 
 # A pipeline the job could not load on every process fails on all of them, printed once.
 printf 'pipeline: {name: x}\nnodes:\n  - {id: a, type: no.such}\n' > bad.yaml

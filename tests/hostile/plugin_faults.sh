@@ -38,4 +38,14 @@ expect_run "a registration that throws a non-std exception is a named load probl
   -- "$TF" plugins --plugin-path "$HOSTILE/bad_register"
 expect_run "... and the other plugins still work" 0 "measurements processed" \
   -- "$TF" run "$TMP/none.yaml" --plugin-path "$MIS" --plugin-path "$HOSTILE/bad_register" --out "$TMP/out"
+# The same for a plugin's merge(), which runs on the aggregating instance, in run order: the
+# merge of run 7 fails, whichever thread ran it (test.fail_run, from the test-plugins folder).
+FAIL_YAML="$INPUTS/../../cli/data/mpi_fail.yaml"
+fail_run() { "$TF" run "$FAIL_YAML" --plugin-path "$PLUGINS/../test-plugins" --out "$TMP/out" --no-progress "$@"; }
+boom="node 'boom' \(test.fail_run from [^)]*tfplugin_test_fail_run.so\)"
+expect_run "a DataError in merge() names the run and the node" 2 "data error: run 7: $boom: test.fail_run: deliberate failure" \
+  -- fail_run --threads 2 --set boom.during=merge
+expect_run "a std::exception in merge() is an internal error naming the node and run" 3 \
+  "internal error: $boom during run 7 threw std::logic_error: test.fail_run: deliberate bug" \
+  -- fail_run --threads 2 --set boom.during=merge --set boom.kind=bug
 finish

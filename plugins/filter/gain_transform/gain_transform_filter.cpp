@@ -193,11 +193,13 @@ class GainTransformFilter final : public FilterFrontEnd<GainTransformFilter> {
   // the decoupled blocks stand for, in motion.hpp's layout like filter.ekf's Singer state.
   // Formed in a fixed-size matrix and copied once (the Estimate's is sized at run time).
   void fill_estimate(Estimate& e) const {
+    e.state.resize(9);
     for (int i = 0; i < 9; ++i) e.state(i) = x_[i];
-    Eigen::Matrix<double, 9, 9> P;
-    enu_covariance(B_, frame_.u, P);
+    // Formed in place: a 9x9 Estimate::covariance is 81 contiguous doubles, column-major, as a
+    // fixed-size 9x9 is (no copy of a local one).
     e.covariance.resize(9, 9);
-    e.covariance.topLeftCorner<9, 9>() = P;
+    Eigen::Map<Eigen::Matrix<double, 9, 9>> P(e.covariance.data());
+    enu_covariance(B_, frame_.u, P);
     constexpr int kIndex[6] = {state_index(0, 0), state_index(1, 0), state_index(2, 0),
                                state_index(0, 1), state_index(1, 1), state_index(2, 1)};
     for (int j = 0; j < 6; ++j) {
