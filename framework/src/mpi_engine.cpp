@@ -214,12 +214,14 @@ Failure decode(const std::string& s) {
 }
 
 // The failure of run `run` on `rank`. Errors from plugin code come through rethrow_from_plugin,
-// which names the node and already starts a DataError's message with the run.
+// which names the node and the run already ("run R: node ..." for bad data, "node ... during
+// run R threw" for a bug): the run is added only where the message lacks it.
 Failure describe(int rank, std::uint64_t run, const std::exception& e) {
   if (const auto* c = dynamic_cast<const ConfigError*>(&e)) return {FailureKind::Config, c->message()};
   const std::string prefix = "run " + std::to_string(run) + ": ";
   std::string what = e.what();
-  if (what.rfind(prefix, 0) != 0) what = prefix + what;
+  const bool names_run = what.rfind(prefix, 0) == 0 || what.find(" during run " + std::to_string(run) + " ") != std::string::npos;
+  if (!names_run) what = prefix + what;
   if (dynamic_cast<const std::bad_alloc*>(&e))  // as one process reports it: exit 3
     return {FailureKind::Internal, "rank " + std::to_string(rank) + ": " + prefix + "out of memory"};
   const FailureKind kind = dynamic_cast<const InternalError*>(&e) ? FailureKind::Internal : FailureKind::Data;
