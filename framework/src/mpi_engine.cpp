@@ -23,6 +23,7 @@
 #include <limits>
 #include <map>
 #include <mutex>
+#include <new>
 #include <thread>
 
 namespace trackflow::host {
@@ -213,12 +214,16 @@ Failure decode(const std::string& s) {
 }
 
 // The failure of run `run` on `rank`. Errors from plugin code come through rethrow_from_plugin,
-// which names the node and already starts a DataError's message with the run.
+// which names the node and the run already ("run R: node ..." for bad data, "node ... during
+// run R threw" for a bug): the run is added only where the message lacks it.
 Failure describe(int rank, std::uint64_t run, const std::exception& e) {
   if (const auto* c = dynamic_cast<const ConfigError*>(&e)) return {FailureKind::Config, c->message()};
   const std::string prefix = "run " + std::to_string(run) + ": ";
   std::string what = e.what();
-  if (what.rfind(prefix, 0) != 0) what = prefix + what;
+  const bool names_run = what.rfind(prefix, 0) == 0 || what.find(" during run " + std::to_string(run) + " ") != std::string::npos;
+  if (!names_run) what = prefix + what;
+  if (dynamic_cast<const std::bad_alloc*>(&e))  // as one process reports it: exit 3
+    return {FailureKind::Internal, "rank " + std::to_string(rank) + ": " + prefix + "out of memory"};
   const FailureKind kind = dynamic_cast<const InternalError*>(&e) ? FailureKind::Internal : FailureKind::Data;
   return {kind, "rank " + std::to_string(rank) + ": " + what};
 }
@@ -234,6 +239,7 @@ Outcome worker_rank(const Graph& g, const PluginRegistry& registry, const RunOpt
   std::deque<std::pair<int, std::string>> outbox;  // (tag, payload)
   bool shutdown = false;
   auto worker = [&]() {
+    prepare_thread_for_crash_reports();  // a stack overflow in a plugin is named here too
     // As in engine.cpp: a sink that keeps a large run's rows in a temporary file asks
     // output_directory() (none there, or none possible: they stay in memory).
     OutputDirectoryScope dir(opt.output_dir);
@@ -362,6 +368,8 @@ Outcome root_rank(const Graph& g, const PluginRegistry& registry, const RunOptio
       merger.complete(run, std::move(rec));
     } catch (const ConfigError& e) {
       fail({FailureKind::Config, e.message()});
+    } catch (const std::bad_alloc&) {
+      fail({FailureKind::Internal, "rank 0: run " + std::to_string(run) + ": out of memory"});
     } catch (const std::exception& e) {
       fail({dynamic_cast<const InternalError*>(&e) ? FailureKind::Internal : FailureKind::Data,
             std::string("rank 0: ") + e.what()});
@@ -370,6 +378,7 @@ Outcome root_rank(const Graph& g, const PluginRegistry& registry, const RunOptio
 
   std::atomic<unsigned> active{threads};
   auto worker = [&]() {
+    prepare_thread_for_crash_reports();
     OutputDirectoryScope dir(opt.output_dir);  // merges happen here too: sink.csv streams its file
     try {
       Runner runner(g, registry, opt);

@@ -142,6 +142,7 @@ void merge_run_diagnostics(const RunRecord& rec, std::uint64_t run, std::uint64_
 }
 
 void RunOrderMerge::complete(std::uint64_t run, RunRecord&& rec) {
+  if (failed_) return;
   pending_.emplace(run, std::move(rec));
   for (auto it = pending_.find(next_); it != pending_.end(); it = pending_.find(next_)) {
     Activity merging{"merging the results of a run", &labels_};
@@ -155,6 +156,8 @@ void RunOrderMerge::complete(std::uint64_t run, RunRecord&& rec) {
           aggregate_.components[i]->merge(*it->second.results[i]);
         }
     } catch (...) {
+      failed_ = true;
+      pending_.clear();
       rethrow_from_plugin();
     }
     merge_run_diagnostics(it->second, it->first, runs_, out_);

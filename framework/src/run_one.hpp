@@ -51,7 +51,10 @@ class RunOrderMerge {
  public:
   RunOrderMerge(GraphInstance& aggregate, const NodeLabels& labels, std::uint64_t runs, Outcome& out)
       : aggregate_(aggregate), labels_(labels), runs_(runs), out_(out) {}
-  // Adds run `run` and merges every run that is now next in order.
+  RunOrderMerge(GraphInstance&, NodeLabels&&, std::uint64_t, Outcome&) = delete;  // it keeps the labels
+  // Adds run `run` and merges every run that is now next in order. After a merge() has thrown,
+  // runs are dropped: merging the failed run again would repeat the earlier nodes' merges (a
+  // sink's rows written twice) for a job that fails anyway.
   void complete(std::uint64_t run, RunRecord&& rec);
   // How many runs are merged (the next one to merge).
   std::uint64_t merged() const { return next_; }
@@ -63,6 +66,7 @@ class RunOrderMerge {
   Outcome& out_;
   std::map<std::uint64_t, RunRecord> pending_;
   std::uint64_t next_ = 0;
+  bool failed_ = false;
 };
 
 // finish() of every node of the aggregating instance, on the calling thread, in graph order;

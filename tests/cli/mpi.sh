@@ -74,7 +74,7 @@ checks=$((checks + 1)); echo "ok: printed once"
 # order, and a failure there names the node and the run merged, not the run that just finished.
 fail_job() { "${MPIRUN[@]}" "$TF" run "$DATA/mpi_fail.yaml" --threads 2 --no-progress --plugin-path "$TEST_PLUGINS" --out fail "$@"; }
 expect_run "a plugin bug in a run: exit 3, naming rank, run and node" 3 \
-  "internal error: rank [0-2]: run 7: $boom during run 7 threw std::logic_error: test.fail_run: deliberate bug" -- fail_job --set boom.kind=bug
+  "internal error: rank [0-2]: $boom during run 7 threw std::logic_error: test.fail_run: deliberate bug" -- fail_job --set boom.kind=bug
 expect_run "a DataError in merge() on rank 0: exit 2, naming run and node" 2 \
   "data error: rank 0: run 7: $boom: test.fail_run: deliberate failure" -- fail_job --set boom.during=merge
 expect_run "a plugin bug in merge() on rank 0: exit 3, naming node and run" 3 \

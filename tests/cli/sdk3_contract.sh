@@ -74,40 +74,30 @@ awk 'BEGIN {
   }
 }' > "$TMP/log.csv"
 invalid=$(awk -F, 'NR > 1 && $5 == 0' "$TMP/log.csv" | wc -l)
+# coast_case LABEL NODES...: the log, then the given node lines (the last one is the filter, `f`);
+# every invalid row must be coasted.
+coast_case() {
+  local label=$1
+  shift
+  { cat <<'YAML'
+pipeline: { name: coast, seed: 1, runs: 1 }
+nodes:
+  - id: log
+    type: source.csv
+    params: { path: log.csv, valid_column: valid, sigma_range: 3 m, sigma_azimuth: 1 mrad, sigma_elevation: 1 mrad }
+YAML
+    printf '%s\n' "$@"; } > "$TMP/coast.yaml"
+  expect_run "$label coasts the $invalid invalid rows" 0 "^  coasted +$invalid$" -- "$TF" run "$TMP/coast.yaml" --no-progress
+}
 for conv in convert.classical convert.debiased convert.unbiased convert.unbiased_modified; do
   for filt in filter.kalman filter.decoupled; do
-    cat > "$TMP/coast.yaml" <<YAML
-pipeline: { name: coast, seed: 1, runs: 1 }
-nodes:
-  - id: log
-    type: source.csv
-    params: { path: log.csv, valid_column: valid, sigma_range: 3 m, sigma_azimuth: 1 mrad, sigma_elevation: 1 mrad }
-  - id: cm
-    type: $conv
-    input: log
-  - id: f
-    type: $filt
-    input: cm
-YAML
-    expect_run "$conv -> $filt coasts the $invalid invalid rows" 0 "^  coasted +$invalid$" -- "$TF" run "$TMP/coast.yaml" --no-progress
+    coast_case "$conv -> $filt" "  - { id: cm, type: $conv, input: log }" "  - { id: f, type: $filt, input: cm }"
   done
 done
-for filt in filter.ekf filter.ukf filter.ekf_spherical "filter.gain_transform"; do
-  extra=""
-  [ "$filt" = filter.gain_transform ] && extra="params: { singer_sigma: 5 m/s2 }"
-  cat > "$TMP/coast.yaml" <<YAML
-pipeline: { name: coast, seed: 1, runs: 1 }
-nodes:
-  - id: log
-    type: source.csv
-    params: { path: log.csv, valid_column: valid, sigma_range: 3 m, sigma_azimuth: 1 mrad, sigma_elevation: 1 mrad }
-  - id: f
-    type: $filt
-    input: log
-    $extra
-YAML
-  expect_run "$filt coasts the $invalid invalid rows" 0 "^  coasted +$invalid$" -- "$TF" run "$TMP/coast.yaml" --no-progress
+for filt in filter.ekf filter.ukf filter.ekf_spherical; do
+  coast_case "$filt" "  - { id: f, type: $filt, input: log }"
 done
+coast_case filter.gain_transform "  - { id: f, type: filter.gain_transform, input: log, params: { singer_sigma: 5 m/s2 } }"
 
 # 4. The engine restores adapted process noise at every run: test.q_ramp doubles q at every step
 # and publishes the q it found; filter.kalman does not restore q itself. Every run's first

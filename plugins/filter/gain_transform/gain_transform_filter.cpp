@@ -191,7 +191,6 @@ class GainTransformFilter final : public FilterFrontEnd<GainTransformFilter> {
 
   // The published covariance is blkdiag(D) P̄ blkdiag(D)' (enu_covariance()): the ENU covariance
   // the decoupled blocks stand for, in motion.hpp's layout like filter.ekf's Singer state.
-  // Formed in a fixed-size matrix and copied once (the Estimate's is sized at run time).
   void fill_estimate(Estimate& e) const {
     e.state.resize(9);
     for (int i = 0; i < 9; ++i) e.state(i) = x_[i];
