@@ -66,15 +66,6 @@ std::string recv_bytes(MPI_Comm c, int src, int tag) {
 void send_runs(MPI_Comm c, int dest, const std::vector<std::uint64_t>& runs) {
   MPI_Send(runs.data(), static_cast<int>(runs.size()), MPI_UINT64_T, dest, kAssign, c);
 }
-std::vector<std::uint64_t> recv_runs(MPI_Comm c, int src) {
-  MPI_Status st;
-  MPI_Probe(src, kAssign, c, &st);
-  int n = 0;
-  MPI_Get_count(&st, MPI_UINT64_T, &n);
-  std::vector<std::uint64_t> runs(static_cast<size_t>(n));
-  MPI_Recv(runs.data(), n, MPI_UINT64_T, src, kAssign, c, MPI_STATUS_IGNORE);
-  return runs;
-}
 
 class Session final : public MpiSession {
  public:
@@ -195,16 +186,19 @@ long long fingerprint(const Graph& g, const RunOptions& opt) {
 
 // How many runs rank 0 hands out ahead of the oldest one not merged: four per thread of the job
 // (every process runs `threads`), as engine.cpp's window. TRACKFLOW_MPI_WINDOW=N sets it (tests
-// run with 1 and 2, where most requests wait for a merge); a value that is not a whole number
-// >= 1 is reported in the summary's warnings and the default used (rank 0 cannot stop here:
+// run with 1, where most requests wait for a merge); a value that is not a whole number from 1
+// to 10^12 - 1 is reported in the summary's warnings and the default used (rank 0 cannot stop here:
 // the other processes already wait for runs).
 std::uint64_t mpi_window(unsigned threads, int processes, std::vector<std::string>& warnings) {
   const std::uint64_t fallback = 4 * static_cast<std::uint64_t>(threads) * static_cast<std::uint64_t>(std::max(1, processes));
   if (const char* v = std::getenv("TRACKFLOW_MPI_WINDOW")) {
-    char* end = nullptr;
-    const unsigned long long n = std::strtoull(v, &end, 10);
-    if (end != v && *end == '\0' && n >= 1) return n;
-    warnings.push_back(std::string("engine: TRACKFLOW_MPI_WINDOW='") + v + "' is not a whole number >= 1; using " +
+    const std::string text = v;
+    // Digits only (strtoull would take "-1" as 2^64 - 1), and small enough to add to a run index.
+    if (!text.empty() && text.size() <= 12 && text.find_first_not_of("0123456789") == std::string::npos) {
+      const std::uint64_t n = std::stoull(text);
+      if (n >= 1) return n;
+    }
+    warnings.push_back(std::string("engine: TRACKFLOW_MPI_WINDOW='") + v + "' is not a whole number from 1 to 999999999999; using " +
                        std::to_string(fallback));
   }
   return fallback;
@@ -296,21 +290,28 @@ Outcome worker_rank(const Graph& g, const PluginRegistry& registry, const RunOpt
   for (unsigned t = 0; t < threads; ++t) pool.emplace_back(worker);
   std::uint64_t in_flight = 0;
   bool stop = false, asked = false;
+  std::vector<std::uint64_t> assigned(threads);  // rank 0 answers a request with at most as many runs
+  MPI_Request answer = MPI_REQUEST_NULL;
   try {
     for (;;) {
       // Rank 0 may hold a request back (its window), so the answer is polled for, not waited on:
       // meanwhile this process's finished runs still go out, and one of them may be the run rank 0
       // waits for. Runs that come after a failure here are still run (they report).
+      // The receive is posted with the request, so rank 0's answer never waits for this process
+      // (which may be inside a long send of results to it).
       if (!stop && !asked && in_flight < threads) {
         send_u64(comm, 0, kRequest, threads - in_flight);
+        MPI_Irecv(assigned.data(), static_cast<int>(assigned.size()), MPI_UINT64_T, 0, kAssign, comm, &answer);
         asked = true;
       }
       bool answered = false;
       if (asked) {
-        int flag = 0;
-        MPI_Iprobe(0, kAssign, comm, &flag, MPI_STATUS_IGNORE);
+        int flag = 0, count = 0;
+        MPI_Status st;
+        MPI_Test(&answer, &flag, &st);
         if (flag) {
-          const std::vector<std::uint64_t> runs = recv_runs(comm, 0);
+          MPI_Get_count(&st, MPI_UINT64_T, &count);
+          const std::vector<std::uint64_t> runs(assigned.begin(), assigned.begin() + count);
           asked = false;
           answered = true;
           if (runs.empty()) {
@@ -329,7 +330,13 @@ Outcome worker_rank(const Graph& g, const PluginRegistry& registry, const RunOpt
       std::deque<std::pair<int, std::string>> ready;
       {
         std::unique_lock<std::mutex> lock(m);
-        if (!answered) cv_out.wait_for(lock, std::chrono::microseconds(200), [&] { return !outbox.empty(); });
+        if (answered) {
+          // free threads may ask again at once
+        } else if (asked) {  // an answer may come: look again soon
+          cv_out.wait_for(lock, std::chrono::microseconds(200), [&] { return !outbox.empty(); });
+        } else {  // every thread busy (or stopping): only a finished run can come
+          cv_out.wait(lock, [&] { return !outbox.empty(); });
+        }
         ready.swap(outbox);
       }
       for (auto& [tag, payload] : ready) {
@@ -377,18 +384,23 @@ Outcome root_rank(const Graph& g, const PluginRegistry& registry, const RunOptio
   std::atomic<bool> failed{false};
   Failure failure;
   bool has_failure = false;
+  std::condition_variable window_moved;  // rank 0's own threads wait on it (with merge_mutex)
   auto fail = [&](Failure f) {
-    std::lock_guard<std::mutex> lock(dispense_mutex);
-    if (!has_failure) {
-      failure = std::move(f);
-      has_failure = true;
+    {
+      std::lock_guard<std::mutex> lock(dispense_mutex);
+      if (!has_failure) {
+        failure = std::move(f);
+        has_failure = true;
+      }
+      failed = true;
     }
-    failed = true;
+    window_moved.notify_all();
   };
   auto take = [&](std::uint64_t n) {
     std::vector<std::uint64_t> out_runs;
     std::lock_guard<std::mutex> lock(dispense_mutex);
-    const std::uint64_t limit = merged_runs.load() + window;
+    const std::uint64_t merged = merged_runs.load();
+    const std::uint64_t limit = window >= runs - std::min(merged, runs) ? runs : merged + window;
     while (!failed && next_run < runs && next_run < limit && out_runs.size() < n) out_runs.push_back(next_run++);
     return out_runs;
   };
@@ -403,7 +415,6 @@ Outcome root_rank(const Graph& g, const PluginRegistry& registry, const RunOptio
   RunOrderMerge merger(aggregate, aggregate_labels, runs, out);
   std::mutex merge_mutex;
   // A merge that fails names its node and run (rethrow_from_plugin), not the run just finished.
-  std::condition_variable window_moved;  // rank 0's own threads wait on it (with merge_mutex)
   auto complete = [&](std::uint64_t run, RunRecord&& rec) {
     try {
       std::lock_guard<std::mutex> lock(merge_mutex);
