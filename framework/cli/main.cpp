@@ -53,6 +53,13 @@ Exit codes: 0 ok, 1 an `expect` check failed, 2 bad configuration or input data
 Plugins are searched in: <trackflow>/../lib/trackflow/plugins (built in), --plugin-path
 DIRs, the pipeline's plugin_paths (only with --trust-plugin-paths), then
 $TRACKFLOW_PLUGIN_PATH (colon-separated). Built-in types are replaced only with --replace-type.
+
+Across machines (a build with MPI: `trackflow --version` says so): `mpirun -np N trackflow run
+FILE --threads T` (Slurm: `srun --mpi=pmix ...`) shares the runs among N processes of T threads;
+every output is byte-identical to one process's with the same seed. Also for `sweep`.
+Environment: TRACKFLOW_PLUGIN_PATH (above); TRACKFLOW_CRASH_HANDLER=0 leaves fatal signals to the
+system (a core dump); TRACKFLOW_MPI_WINDOW=N, under mpirun, how many runs are handed out ahead of
+the oldest one not yet merged (default 4 per thread of the job).
 )";
 
 // The thread counts accepted; 0 means one per core.

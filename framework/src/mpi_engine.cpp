@@ -66,15 +66,6 @@ std::string recv_bytes(MPI_Comm c, int src, int tag) {
 void send_runs(MPI_Comm c, int dest, const std::vector<std::uint64_t>& runs) {
   MPI_Send(runs.data(), static_cast<int>(runs.size()), MPI_UINT64_T, dest, kAssign, c);
 }
-std::vector<std::uint64_t> recv_runs(MPI_Comm c, int src) {
-  MPI_Status st;
-  MPI_Probe(src, kAssign, c, &st);
-  int n = 0;
-  MPI_Get_count(&st, MPI_UINT64_T, &n);
-  std::vector<std::uint64_t> runs(static_cast<size_t>(n));
-  MPI_Recv(runs.data(), n, MPI_UINT64_T, src, kAssign, c, MPI_STATUS_IGNORE);
-  return runs;
-}
 
 class Session final : public MpiSession {
  public:
@@ -193,6 +184,26 @@ long long fingerprint(const Graph& g, const RunOptions& opt) {
   return static_cast<long long>(h >> 1);
 }
 
+// How many runs rank 0 hands out ahead of the oldest one not merged: four per thread of the job
+// (every process runs `threads`), as engine.cpp's window. TRACKFLOW_MPI_WINDOW=N sets it (tests
+// run with 1, where most requests wait for a merge); a value that is not a whole number from 1
+// to 10^12 - 1 is reported in the summary's warnings and the default used (rank 0 cannot stop here:
+// the other processes already wait for runs).
+std::uint64_t mpi_window(unsigned threads, int processes, std::vector<std::string>& warnings) {
+  const std::uint64_t fallback = 4 * static_cast<std::uint64_t>(threads) * static_cast<std::uint64_t>(std::max(1, processes));
+  if (const char* v = std::getenv("TRACKFLOW_MPI_WINDOW")) {
+    const std::string text = v;
+    // Digits only (strtoull would take "-1" as 2^64 - 1), and small enough to add to a run index.
+    if (!text.empty() && text.size() <= 12 && text.find_first_not_of("0123456789") == std::string::npos) {
+      const std::uint64_t n = std::stoull(text);
+      if (n >= 1) return n;
+    }
+    warnings.push_back(std::string("engine: TRACKFLOW_MPI_WINDOW='") + v + "' is not a whole number from 1 to 999999999999; using " +
+                       std::to_string(fallback));
+  }
+  return fallback;
+}
+
 // A failure of a run, as rank 0 will report it.
 // What the CLI makes of it, as the threaded engine's errors: a ConfigError exits 2 with its message
 // as it is, a DataError exits 2, an InternalError (a plugin's bug: rethrow_from_plugin) exits 3.
@@ -278,28 +289,54 @@ Outcome worker_rank(const Graph& g, const PluginRegistry& registry, const RunOpt
   std::vector<std::thread> pool;
   for (unsigned t = 0; t < threads; ++t) pool.emplace_back(worker);
   std::uint64_t in_flight = 0;
-  bool stop = false;
+  bool stop = false, asked = false;
+  std::vector<std::uint64_t> assigned(threads);  // rank 0 answers a request with at most as many runs
+  MPI_Request answer = MPI_REQUEST_NULL;
   try {
     for (;;) {
-      if (!stop && in_flight < threads) {
+      // Rank 0 may hold a request back (its window), so the answer is polled for, not waited on:
+      // meanwhile this process's finished runs still go out, and one of them may be the run rank 0
+      // waits for. Runs that come after a failure here are still run (they report).
+      // The receive is posted with the request, so rank 0's answer never waits for this process
+      // (which may be inside a long send of results to it).
+      if (!stop && !asked && in_flight < threads) {
         send_u64(comm, 0, kRequest, threads - in_flight);
-        const std::vector<std::uint64_t> runs = recv_runs(comm, 0);
-        if (runs.empty()) {
-          stop = true;
-        } else {
-          {
-            std::lock_guard<std::mutex> lock(m);
-            queue.insert(queue.end(), runs.begin(), runs.end());
+        MPI_Irecv(assigned.data(), static_cast<int>(assigned.size()), MPI_UINT64_T, 0, kAssign, comm, &answer);
+        asked = true;
+      }
+      bool answered = false;
+      if (asked) {
+        int flag = 0, count = 0;
+        MPI_Status st;
+        MPI_Test(&answer, &flag, &st);
+        if (flag) {
+          MPI_Get_count(&st, MPI_UINT64_T, &count);
+          const std::vector<std::uint64_t> runs(assigned.begin(), assigned.begin() + count);
+          asked = false;
+          answered = true;
+          if (runs.empty()) {
+            stop = true;
+          } else {
+            {
+              std::lock_guard<std::mutex> lock(m);
+              queue.insert(queue.end(), runs.begin(), runs.end());
+            }
+            in_flight += runs.size();
+            cv_work.notify_all();
           }
-          in_flight += runs.size();
-          cv_work.notify_all();
         }
       }
-      if (in_flight == 0 && stop) break;
+      if (in_flight == 0 && stop && !asked) break;
       std::deque<std::pair<int, std::string>> ready;
       {
         std::unique_lock<std::mutex> lock(m);
-        cv_out.wait(lock, [&] { return !outbox.empty(); });
+        if (answered) {
+          // free threads may ask again at once
+        } else if (asked) {  // an answer may come: look again soon
+          cv_out.wait_for(lock, std::chrono::microseconds(200), [&] { return !outbox.empty(); });
+        } else {  // every thread busy (or stopping): only a finished run can come
+          cv_out.wait(lock, [&] { return !outbox.empty(); });
+        }
         ready.swap(outbox);
       }
       for (auto& [tag, payload] : ready) {
@@ -336,25 +373,41 @@ Outcome root_rank(const Graph& g, const PluginRegistry& registry, const RunOptio
   // runs here: streaming sinks (sink.csv) write into --out as they merge, as in engine.cpp.
   OutputDirectoryScope dir(opt.output_dir);
 
-  // Handing out runs: in order, to whoever asks (its own threads and the other processes).
+  // Handing out runs: in order, to whoever asks (its own threads and the other processes), at most
+  // `window` runs ahead of the oldest one not yet merged, as engine.cpp's workers: finished runs
+  // wait on this process until every earlier run is merged, so a slow run must not let them pile
+  // up without bound. A request the window holds back is answered when the window moves.
   std::mutex dispense_mutex;
   std::uint64_t next_run = 0;
+  std::atomic<std::uint64_t> merged_runs{0};
+  const std::uint64_t window = mpi_window(threads, world.size(), out.warnings);
   std::atomic<bool> failed{false};
   Failure failure;
   bool has_failure = false;
+  std::condition_variable window_moved;  // rank 0's own threads wait on it (with merge_mutex)
   auto fail = [&](Failure f) {
-    std::lock_guard<std::mutex> lock(dispense_mutex);
-    if (!has_failure) {
-      failure = std::move(f);
-      has_failure = true;
+    {
+      std::lock_guard<std::mutex> lock(dispense_mutex);
+      if (!has_failure) {
+        failure = std::move(f);
+        has_failure = true;
+      }
+      failed = true;
     }
-    failed = true;
+    window_moved.notify_all();
   };
   auto take = [&](std::uint64_t n) {
     std::vector<std::uint64_t> out_runs;
     std::lock_guard<std::mutex> lock(dispense_mutex);
-    while (!failed && next_run < runs && out_runs.size() < n) out_runs.push_back(next_run++);
+    const std::uint64_t merged = merged_runs.load();
+    const std::uint64_t limit = window >= runs - std::min(merged, runs) ? runs : merged + window;
+    while (!failed && next_run < runs && next_run < limit && out_runs.size() < n) out_runs.push_back(next_run++);
     return out_runs;
+  };
+  // No run will be handed out any more (all are, or the job failed).
+  auto exhausted = [&] {
+    std::lock_guard<std::mutex> lock(dispense_mutex);
+    return failed || next_run >= runs;
   };
 
   // Merging in run order, as engine.cpp does, whichever thread or process ran the run.
@@ -366,6 +419,8 @@ Outcome root_rank(const Graph& g, const PluginRegistry& registry, const RunOptio
     try {
       std::lock_guard<std::mutex> lock(merge_mutex);
       merger.complete(run, std::move(rec));
+      merged_runs = merger.merged();
+      window_moved.notify_all();
     } catch (const ConfigError& e) {
       fail({FailureKind::Config, e.message()});
     } catch (const std::bad_alloc&) {
@@ -384,7 +439,12 @@ Outcome root_rank(const Graph& g, const PluginRegistry& registry, const RunOptio
       Runner runner(g, registry, opt);
       for (;;) {
         const auto mine = take(1);
-        if (mine.empty()) break;
+        if (mine.empty()) {
+          if (exhausted()) break;
+          std::unique_lock<std::mutex> lock(merge_mutex);  // the window is full: wait for a merge
+          window_moved.wait_for(lock, std::chrono::milliseconds(10));
+          continue;
+        }
         RunRecord rec;
         try {
           rec = runner.run(mine[0]);
@@ -404,18 +464,31 @@ Outcome root_rank(const Graph& g, const PluginRegistry& registry, const RunOptio
   std::vector<std::thread> pool;
   for (unsigned t = 0; t < threads; ++t) pool.emplace_back(worker);
   int running_ranks = world.size() - 1;
+  std::deque<std::pair<int, std::uint64_t>> held_back;  // requests (rank, runs) the window holds back
   auto last_progress = std::chrono::steady_clock::now();
   try {
     while (running_ranks > 0 || active.load() > 0) {
+      while (!held_back.empty()) {
+        const auto given = take(held_back.front().second);
+        if (given.empty() && !exhausted()) break;
+        send_runs(comm, held_back.front().first, given);
+        held_back.pop_front();
+      }
       int flag = 0;
       MPI_Status st;
       MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, comm, &flag, &st);
       if (flag) {
         const int src = st.MPI_SOURCE;
         switch (st.MPI_TAG) {
-          case kRequest:
-            send_runs(comm, src, take(recv_u64(comm, src, kRequest)));
+          case kRequest: {
+            const std::uint64_t n = recv_u64(comm, src, kRequest);
+            const auto given = take(n);
+            if (!given.empty() || exhausted())
+              send_runs(comm, src, given);  // none: stop
+            else
+              held_back.emplace_back(src, n);
             break;
+          }
           case kResult: {
             const std::string bytes = recv_bytes(comm, src, kResult);
             ByteReader in(bytes.data(), bytes.size());

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Purpose: an MPI job (mpirun --oversubscribe -np 3, threads per process) gives byte-identical outputs to one process with --threads 1 — metrics JSON, summary, series CSV, report series and track, sweep table — for EVERY pipeline in pipelines/ (so a plugin added later without RunResultCodec fails here: the MPI engine refuses it) and for sink.csv with runs large enough to spill, and a failing run stops the job naming the rank and the run.
+# Purpose: an MPI job (mpirun --oversubscribe -np 3, threads per process; also with rank 0's window of runs ahead of the oldest unmerged one at 1) gives byte-identical outputs to one process with --threads 1 — metrics JSON, summary, series CSV, report series and track, sweep table — for EVERY pipeline in pipelines/ (so a plugin added later without RunResultCodec fails here: the MPI engine refuses it) and for sink.csv with runs large enough to spill, and a failing run stops the job naming the rank and the run.
 # Skipped (exit 77) when this trackflow was built without MPI or mpirun is not installed.
 set -u
 TF=$1
@@ -42,6 +42,16 @@ checks=$((checks + 1)); echo "ok: metrics JSON byte-identical (mpirun -np 3 --th
 n=$(same_dir one job); checks=$((checks + 1)); echo "ok: $n series CSV files byte-identical"
 diff <(summary one.log) <(summary job.log) || fail "summary differs"
 checks=$((checks + 1)); echo "ok: summary identical (all but the timing line)"
+
+# Rank 0 hands out runs at most a window ahead of the oldest run not merged (as the threaded
+# engine's workers), so a slow run cannot make finished ones pile up there. With a window of 1
+# nearly every request waits for a merge: the same bytes, and no process waits forever.
+TRACKFLOW_MPI_WINDOW=1 "${MPIRUN[@]}" "$TF" run "$P" --threads 2 --no-progress --series --out w1 --metrics-json w1.json > w1.log 2>&1 ||
+  fail "mpirun with a window of 1: $(cat w1.log)"
+cmp one.json w1.json || fail "metrics JSON differs with a window of 1"
+n=$(same_dir one w1)
+diff <(summary one.log) <(summary w1.log) || fail "summary differs with a window of 1"
+checks=$((checks + 1)); echo "ok: window of 1 run: metrics JSON, summary and $n series files identical"
 
 # The report: series and the recorded track of one run through the engine on rank 0.
 "$TF" report "$P" --threads 1 --no-progress --out rone --track-run 5 > rone.log 2>&1 || fail "report, one process: $(cat rone.log)"
