@@ -17,6 +17,12 @@ function(trackflow_add_plugin name)
     VISIBILITY_INLINES_HIDDEN ON
     CXX_STANDARD 20
     CXX_STANDARD_REQUIRED ON)
+  # In the trackflow tree a plugin must link against the SDK alone: an unresolved symbol (one the
+  # host library defines, say) is a link error here rather than a load error in someone's run.
+  # Not under the sanitizers, whose runtime symbols a module leaves to the executable.
+  if(DEFINED TRACKFLOW_PLUGIN_BUILD_DIR AND NOT CMAKE_CXX_FLAGS MATCHES "sanitize")
+    target_link_options(${target} PRIVATE -Wl,--no-undefined)
+  endif()
   if(DEFINED TRACKFLOW_PLUGIN_BUILD_DIR)
     set_target_properties(${target} PROPERTIES LIBRARY_OUTPUT_DIRECTORY ${TRACKFLOW_PLUGIN_BUILD_DIR})
   endif()

@@ -1,6 +1,7 @@
-// Purpose: in-tree test helpers: the SDK's installed fixture (trackflow/testing/plugin_fixture.hpp) bound to this build's plugin folder.
+// Purpose: in-tree test helpers: the SDK's installed fixture (trackflow/testing/plugin_fixture.hpp) and its registry, bound to this build's plugin folder.
 #pragma once
 
+#include <trackflow/host/plugin_fixture_state.hpp>
 #include <trackflow/testing/plugin_fixture.hpp>
 
 #include <memory>
@@ -13,7 +14,7 @@ using testing::drain;
 
 // The fixture of every plugin built in this tree (loaded once per test process).
 const testing::PluginFixture& fixture();
-inline const host::PluginRegistry& registry() { return fixture().registry(); }
+inline const host::PluginRegistry& registry() { return fixture().state().registry; }
 
 // Creates `type` with parameters written as YAML, validated exactly as in a pipeline.
 inline std::shared_ptr<Component> make(const std::string& type, const std::string& yaml_params = "{}",

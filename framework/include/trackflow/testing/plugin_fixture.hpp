@@ -2,12 +2,10 @@
 #pragma once
 
 #include <trackflow/component.hpp>
-#include <trackflow/host/config.hpp>
-#include <trackflow/host/plugins.hpp>
-#include <trackflow/host/validate.hpp>
+#include <trackflow/error.hpp>
+#include <trackflow/params.hpp>
 
 #include <cmath>
-#include <filesystem>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -17,43 +15,29 @@ namespace trackflow::testing {
 
 // The plugins of the given files or folders (tfplugin_*.so), loaded by the same code as
 // `trackflow run`; a problem loading any of them throws, naming the file and the stage.
+// Implemented in the host library (link trackflow::host): this header needs only the SDK.
 class PluginFixture {
  public:
-  explicit PluginFixture(const std::vector<std::string>& files_or_dirs) {
-    std::vector<std::string> dirs;
-    for (const auto& p : files_or_dirs) {
-      if (std::filesystem::is_directory(p))
-        dirs.push_back(p);
-      else
-        registry_.load_file(p);
-    }
-    if (!dirs.empty()) registry_.load_directories(dirs);
-    if (!registry_.problems().empty()) throw std::runtime_error("plugin not loaded: " + registry_.problems()[0].str());
-  }
-
-  const host::PluginRegistry& registry() const { return registry_; }
+  explicit PluginFixture(const std::vector<std::string>& files_or_dirs);
+  ~PluginFixture();
+  PluginFixture(const PluginFixture&) = delete;
+  PluginFixture& operator=(const PluginFixture&) = delete;
 
   // Parameters written as YAML ("{ q: 1 m2/s3 }"), validated exactly as in a pipeline.
   Params params_for(const std::string& type, const std::string& yaml_params = "{}",
-                    const std::string& node_id = "node") const {
-    const host::RegisteredType* t = registry_.find(type);
-    if (!t) throw std::runtime_error("no plugin declares type '" + type + "'");
-    const host::Value v = host::load_yaml_string(yaml_params, "test params");
-    return host::validate_params(t->decl.params, v, node_id, v.loc);
-  }
+                    const std::string& node_id = "node") const;
 
+  // A component of `type` created by its plugin from those parameters; a filter's own annotations
+  // get their slots as in the engine.
   std::shared_ptr<Component> make(const std::string& type, const std::string& yaml_params = "{}",
-                                  const std::string& node_id = "node") const {
-    std::shared_ptr<Component> c = registry_.create(*registry_.find(type), params_for(type, yaml_params, node_id));
-    // A filter's own annotations get their slots as in the engine (graph.cpp).
-    if (auto* f = dynamic_cast<Filter*>(c.get()))
-      if (!f->reserve_own_annotations(static_cast<int>(f->annotation_names().size())))
-        throw std::runtime_error("too many annotations on a " + type);
-    return c;
-  }
+                                  const std::string& node_id = "node") const;
+
+  // The loaded registry, for in-tree tests of the host (its definition is a host header, not installed).
+  struct State;
+  const State& state() const { return *state_; }
 
  private:
-  host::PluginRegistry registry_;
+  std::unique_ptr<State> state_;
 };
 
 // Attaches `adapter` to `filter` the way the engine does: the typed contract is checked (the
