@@ -18,8 +18,8 @@
 //     states are compared as a check that the three compute the same filter. OpenCV is optional:
 //     without it (Debian libopencv-video-dev) its rows are skipped with a message.
 #include "bench_common.hpp"
-#include "chi_square_band.hpp"
-#include "nees.hpp"
+#include "scoring/chi_square_band.hpp"
+#include "scoring/nees.hpp"
 
 #include <trackflow/geometry.hpp>
 #include <trackflow/host/engine.hpp>

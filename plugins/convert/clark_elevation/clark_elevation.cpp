@@ -1,5 +1,5 @@
 // Purpose: convert.clark_elevation — the baseline of paper 004: Clark's refraction bias taken out of each measured elevation directly (paper 004 ref [3]), spherical in, spherical out.
-#include "../../sim/common/refraction.hpp"
+#include "physics/refraction.hpp"
 
 #include <trackflow/plugin.hpp>
 #include <trackflow/run_result_codec.hpp>

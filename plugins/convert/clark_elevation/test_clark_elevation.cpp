@@ -1,5 +1,5 @@
 // Purpose: tests of convert.clark_elevation: the correction at the measured elevation and solved at the corrected one, the elevation covariance mapped by the correction's derivative, and the behaviour below 2 deg.
-#include "../../sim/common/refraction.hpp"
+#include "physics/refraction.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -1,5 +1,5 @@
 // Purpose: convert.debiased — additive debiased converted measurement (Lerro & Bar-Shalom 1993, 3-D per Suchomski 1999).
-#include "statistical_converter.hpp"
+#include "conversion/statistical_converter.hpp"
 
 #include <trackflow/plugin.hpp>
 

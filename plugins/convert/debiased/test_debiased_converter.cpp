@@ -1,5 +1,5 @@
 // Purpose: tests of convert.debiased: average true bias and covariance by nested Gauss–Hermite cubature; Lerro & Bar-Shalom's 2-D form.
-#include "converter_common_checks.hpp"
+#include "conversion/converter_common_checks.hpp"
 
 #include <cmath>
 

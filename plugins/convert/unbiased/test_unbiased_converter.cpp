@@ -1,5 +1,5 @@
 // Purpose: tests of convert.unbiased: unbiased given the truth and averaged true covariance, by Gauss–Hermite cubature; Mo et al.'s eq 11.
-#include "converter_common_checks.hpp"
+#include "conversion/converter_common_checks.hpp"
 
 #include <cmath>
 

@@ -1,5 +1,5 @@
 // Purpose: convert.unbiased — multiplicative unbiased converted measurement (Mo Longbin et al. 1998).
-#include "statistical_converter.hpp"
+#include "conversion/statistical_converter.hpp"
 
 #include <trackflow/plugin.hpp>
 

@@ -1,5 +1,5 @@
 // Purpose: tests of convert.unbiased_modified against posterior moments by Gauss–Hermite cubature and Duan et al.'s printed expressions.
-#include "converter_common_checks.hpp"
+#include "conversion/converter_common_checks.hpp"
 
 #include <cmath>
 

@@ -1,5 +1,5 @@
 // Purpose: convert.unbiased_modified — measurement-conditioned unbiased conversion (Duan, Han & Li 2004).
-#include "statistical_converter.hpp"
+#include "conversion/statistical_converter.hpp"
 
 #include <trackflow/plugin.hpp>
 

@@ -1,6 +1,6 @@
 // Purpose: filter.ekf — extended Kalman filter with a Cartesian ENU state (CV, CA or Singer motion) on spherical [r, az, el(, rdot)] measurements.
-#include "cartesian_radar_filter.hpp"
-#include "ekf_radar_update.hpp"
+#include "estimation/cartesian_radar_filter.hpp"
+#include "estimation/ekf_radar_update.hpp"
 
 #include <trackflow/geometry.hpp>
 #include <trackflow/plugin.hpp>

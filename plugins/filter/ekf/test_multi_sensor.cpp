@@ -8,7 +8,7 @@
 #include <cmath>
 
 #include "plugin_fixture.hpp"
-#include "radar_filter_test_support.hpp"
+#include "estimation/radar_filter_test_support.hpp"
 
 using namespace trackflow;
 using namespace trackflow::filter_test;

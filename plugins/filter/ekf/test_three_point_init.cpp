@@ -1,5 +1,5 @@
 // Purpose: tests of the three-point initialisation: the symmetric paper-000 P0 against the printed matrix and against sample statistics.
-#include "three_point_init.hpp"
+#include "estimation/three_point_init.hpp"
 
 #include <trackflow/rng.hpp>
 

@@ -1,5 +1,5 @@
 // Purpose: tests of the angle-curvature variance near the zenith against numerical Hessians of geometry.hpp's azimuth and elevation.
-#include "zenith_linearisation.hpp"
+#include "estimation/zenith_linearisation.hpp"
 
 #include <trackflow/geometry.hpp>
 

@@ -1,6 +1,6 @@
 // Purpose: filter.imm — interacting multiple model filter: 2-4 Cartesian radar EKF modes (CV, CA, Singer, each with its own noise) mixed on the common Cartesian state, mode probabilities published as annotations.
-#include "cartesian_radar_state.hpp"
-#include "ekf_radar_update.hpp"
+#include "estimation/cartesian_radar_state.hpp"
+#include "estimation/ekf_radar_update.hpp"
 #include "imm_mixing.hpp"
 
 #include <trackflow/common_params.hpp>

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "plugin_fixture.hpp"
-#include "radar_filter_test_support.hpp"
+#include "estimation/radar_filter_test_support.hpp"
 
 using namespace trackflow;
 using namespace trackflow::filter_test;

@@ -42,12 +42,6 @@ struct Settings {
   double convergence_window = 20.0, convergence_ratio = 10.0;
 };
 
-// Names and units of the state, in order (state_layout()).
-constexpr StateComponent kLayout[kN] = {
-    {"x", "m"},         {"vx", "m/s"},  {"vx_prev", "m/s"}, {"y", "m"},         {"vy", "m/s"},
-    {"vy_prev", "m/s"}, {"z", "m"},     {"vz", "m/s"},      {"vz_prev", "m/s"}, {"range", "m"},
-    {"azimuth", "rad"}, {"elevation", "rad"}, {"bias", "rad"}};
-
 class RefractionEkf final : public FilterFrontEnd<RefractionEkf> {
   friend FilterFrontEnd<RefractionEkf>;
 
@@ -75,7 +69,7 @@ class RefractionEkf final : public FilterFrontEnd<RefractionEkf> {
     h.process.axes = NoiseAxes::Enu;
     return h;
   }
-  StateLayout state_layout() const override { return {kLayout, kN}; }
+  StateLayout state_layout() const override { return {rx::kLayout, kN}; }
 
   void finish(Summary& s, const FinishContext& ctx) override {
     FilterFrontEnd::finish(s, ctx);

@@ -1,7 +1,8 @@
 // Purpose: the 13-state augmented model of paper 004 (eq 7-10): Cartesian position, velocity and previous velocity per axis, range, azimuth, elevation and the refraction bias b, with its propagation and analytic Jacobian.
 #pragma once
 
-#include "../../sim/common/refraction.hpp"
+#include "estimation/refraction_ekf_state.hpp"
+#include "physics/refraction.hpp"
 
 #include <trackflow/items.hpp>
 
@@ -11,18 +12,10 @@
 
 namespace trackflow::refraction_ekf {
 
-inline constexpr int kN = 13;
+// The state order (kN, Index, pos/vel/prev) and its names live in plugins/lib
+// (estimation/refraction_ekf_state.hpp): sink.elevation_error reads the bias by that index.
 using State = Eigen::Matrix<double, kN, 1>;
 using Matrix = Eigen::Matrix<double, kN, kN>;
-
-// State order (paper 004 eq 7, with the previous velocity that its dynamics use):
-// [x, vx, vx_prev, y, vy, vy_prev, z, vz, vz_prev, range, azimuth, elevation, b]; x, y, z from the
-// radar in the ENU axes (m), velocities m/s, angles rad. kBias is what sink.elevation_error reads.
-enum Index : int { kX = 0, kY = 3, kZ = 6, kRange = 9, kAzimuth = 10, kElevation = 11, kBias = 12 };
-inline constexpr int kVel = 1, kPrev = 2;  // offsets within an axis block
-inline int pos(int axis) { return 3 * axis; }
-inline int vel(int axis) { return 3 * axis + kVel; }
-inline int prev(int axis) { return 3 * axis + kPrev; }
 
 // How the Cartesian position is advanced. euler: x + T vx (paper 004 §2.1.3, the acceleration
 // enters only through the noise); adams_bashforth2: x + T (3 vx - vx_prev) / 2, i.e. x + T vx +

@@ -1,5 +1,5 @@
 // Purpose: tests of filter.refraction_ekf as a plugin: the bias estimate follows a matched Clark bias on a descending pass, normalisation/scaling off still run finite and report convergence, the low-pass noise estimate, the published (unscaled) estimate and the parameter checks.
-#include "../../sim/common/refraction.hpp"
+#include "physics/refraction.hpp"
 #include "lpf_noise.hpp"
 #include "refraction_ekf_model.hpp"
 

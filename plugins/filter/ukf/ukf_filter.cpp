@@ -1,5 +1,5 @@
 // Purpose: filter.ukf — scaled unscented Kalman filter with a Cartesian ENU state (CV, CA or Singer motion) on spherical [r, az, el(, rdot)] measurements.
-#include "cartesian_radar_filter.hpp"
+#include "estimation/cartesian_radar_filter.hpp"
 #include "sigma_spherical.hpp"
 #include "unscented_transform.hpp"
 

@@ -1,6 +1,6 @@
 // Purpose: sim.radar — measures Truth as spherical range/azimuth/elevation(/range rate) with bias, modelled noise, shot bursts and mode/lock schedules.
-#include "../common/geodesy.hpp"
-#include "../common/refraction.hpp"
+#include "physics/geodesy.hpp"
+#include "physics/refraction.hpp"
 #include "noise_model.hpp"
 #include "shot_noise.hpp"
 #include "time_windows.hpp"

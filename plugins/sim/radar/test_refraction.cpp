@@ -1,5 +1,5 @@
 // Purpose: tests of the refraction models (Clark values and derivatives, the ray trace against an independent ray integration) and of sim.radar's refraction and geodetic site.
-#include "../common/refraction.hpp"
+#include "physics/refraction.hpp"
 
 #include <catch2/catch.hpp>
 

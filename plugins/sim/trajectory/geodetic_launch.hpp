@@ -1,7 +1,7 @@
 // Purpose: a launch profile flown over the WGS-84 ellipsoid: downrange along the geodesic from a geodetic pad, altitude along the ellipsoid normal, in the pipeline's ENU frame.
 #pragma once
 
-#include "../common/geodesy.hpp"
+#include "physics/geodesy.hpp"
 #include "flight_plan.hpp"
 #include "launch_profile.hpp"
 

@@ -1,5 +1,5 @@
 // Purpose: tests of the geodetic sites and the WGS-84 launch path: geodetic <-> ECEF <-> ENU round trip, geodesic downrange and ellipsoidal altitude at the table rows, derivatives, parameter checks.
-#include "../common/geodesy.hpp"
+#include "physics/geodesy.hpp"
 #include "geodetic_launch.hpp"
 #include "launch_profile.hpp"
 

@@ -1,6 +1,6 @@
 // Purpose: sink.angle_error — azimuth and elevation errors in urad of raw measurements and filters, ensemble RMS and mean per analyst-given time interval (paper 003 Tables 3-6).
 #include "interval_sums.hpp"
-#include "truth_match.hpp"
+#include "scoring/truth_match.hpp"
 
 #include <trackflow/common_params.hpp>
 #include <trackflow/error.hpp>

@@ -1,7 +1,7 @@
 // Purpose: sink.elevation_error — a filter's (or a measurement stream's) elevation error against truth in degrees, max and RMS per run and over the ensemble, optionally within an elevation band, and the refraction-bias estimate's error (paper 004 Fig 5).
-#include "../../filter/refraction_ekf/refraction_ekf_model.hpp"
-#include "../../sim/common/refraction.hpp"
-#include "truth_match.hpp"
+#include "estimation/refraction_ekf_state.hpp"
+#include "physics/refraction.hpp"
+#include "scoring/truth_match.hpp"
 
 #include <trackflow/error.hpp>
 #include <trackflow/geometry.hpp>

@@ -1,5 +1,5 @@
 // Purpose: tests of sink.elevation_error: errors in degrees over an elevation band and from a time, per run and over runs, the bias estimate against the true Clark bias, and the wiring checks.
-#include "../../sim/common/refraction.hpp"
+#include "physics/refraction.hpp"
 
 #include <catch2/catch.hpp>
 

@@ -1,5 +1,5 @@
 // Purpose: sink.interval_rmse — a filter's position RMSE next to the measurements' own, interval by interval (e.g. every 60 s of a launch).
-#include "truth_match.hpp"
+#include "scoring/truth_match.hpp"
 
 #include <trackflow/geometry.hpp>
 #include <trackflow/plugin.hpp>

@@ -1,7 +1,7 @@
 // Purpose: sink.metrics' run-ordered accumulation and the ensemble report (RMSE, bias, ANEES, ANIS with chi-square bands).
 #include "ensemble.hpp"
 
-#include "chi_square_band.hpp"
+#include "scoring/chi_square_band.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,5 +1,5 @@
 // Purpose: sink.metrics' per-step ensemble series: one row per time step from the run-ordered per-step sums.
-#include "chi_square_band.hpp"
+#include "scoring/chi_square_band.hpp"
 #include "ensemble.hpp"
 
 #include <cmath>

@@ -1,7 +1,7 @@
 // Purpose: sink.metrics — ensemble RMSE, bias, ANEES and ANIS (with chi-square bands) of one filter against truth.
 #include "ensemble.hpp"
-#include "nees.hpp"
-#include "truth_match.hpp"
+#include "scoring/nees.hpp"
+#include "scoring/truth_match.hpp"
 
 #include <trackflow/geometry.hpp>
 #include <trackflow/plugin.hpp>

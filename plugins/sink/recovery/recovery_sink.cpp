@@ -1,6 +1,6 @@
 // Purpose: sink.recovery — how many samples a filter needs after each shot-noise burst to return near the truth, and its RMSE outside the bursts.
 #include "burst_recovery.hpp"
-#include "truth_match.hpp"
+#include "scoring/truth_match.hpp"
 
 #include <trackflow/plugin.hpp>
 #include <trackflow/run_result_codec.hpp>
