@@ -303,7 +303,12 @@ Outcome worker_rank(const Graph& g, const PluginRegistry& registry, const RunOpt
   const int rank = world.rank();
   AssignedRuns source(g, rank);
   WorkerPool pool(g, registry, opt, source);
-  pool.start(threads);  // a process limit may leave fewer: the assigned runs wait for them
+  // A process limit may leave fewer threads: the runs assigned here wait for them. None: this
+  // process cannot run the runs rank 0 would hand it, and rank 0 would wait for them forever.
+  if (const std::string short_of_threads = pool.start(threads); !short_of_threads.empty() && !pool.running()) {
+    std::fprintf(stderr, "trackflow: rank %d: %s; aborting the job\n", rank, short_of_threads.c_str());
+    MPI_Abort(comm, 3);
+  }
   std::uint64_t in_flight = 0;
   bool stop = false, asked = false;
   std::vector<std::uint64_t> assigned(threads);  // rank 0 answers a request with at most as many runs
