@@ -1,4 +1,4 @@
-// Purpose: the Monte Carlo ensemble across the processes of an MPI job (Open MPI through Boost.MPI): rank 0 hands out runs in order, every process runs them on its threads, results come back as bytes and are merged in run order on rank 0.
+// Purpose: the Monte Carlo ensemble across the processes of an MPI job (Open MPI through Boost.MPI): the MPI-ranks transport of the run dispatcher — rank 0 hands out runs, every process runs them on its threads, results come back as bytes.
 #include <trackflow/host/guard.hpp>
 #include <trackflow/host/mpi.hpp>
 #include <trackflow/rng.hpp>
@@ -6,22 +6,19 @@
 #include <trackflow/version.hpp>
 
 #include "mpi_launch.hpp"
-#include "run_one.hpp"
+#include "run_dispatcher.hpp"
+#include "worker_pool.hpp"
 
 #include <boost/mpi/collectives.hpp>
 #include <boost/mpi/communicator.hpp>
 #include <boost/mpi/environment.hpp>
 
 #include <algorithm>
-#include <atomic>
 #include <chrono>
-#include <cmath>
 #include <condition_variable>
 #include <cstdio>
 #include <cstdlib>
 #include <deque>
-#include <limits>
-#include <map>
 #include <mutex>
 #include <new>
 #include <thread>
@@ -33,7 +30,7 @@ namespace mpi = boost::mpi;
 
 // Point-to-point messages of one distributed run. Workers (ranks > 0) send kRequest (how many
 // runs they can take) and get kAssign (run indices; none: stop); they send each run's kResult
-// (the index, then the record's bytes) or kError, then kDone; rank 0 ends with kFinal (0 ok,
+// (the index, then the record's bytes) or kError (the index, then the failure), then kDone; rank 0 ends with kFinal (0 ok,
 // 1 failed) to each once all are done, so every process leaves at the same point.
 enum Tag : int { kRequest = 101, kAssign, kResult, kError, kDone, kFinal, kPayload };
 
@@ -97,57 +94,33 @@ class Session final : public MpiSession {
   mpi::communicator world_;
 };
 
-// One instance of the graph on one thread, running whole runs (the steps of engine.cpp's worker).
-struct Runner {
-  const Graph& g;
-  const RunOptions& opt;
-  GraphInstance inst;
-  std::vector<Filter*> filters;
-  NodeLabels labels;
-  Runner(const Graph& graph, const PluginRegistry& registry, const RunOptions& o)
-      : g(graph), opt(o), inst(instantiate(graph, registry)), filters(filters_of(inst)), labels(labels_of(g, inst)) {}
-  RunRecord run(std::uint64_t run) {
-    const size_t N = g.nodes.size();
-    RunRecord rec;
-    {
-      Activity running{"running", &labels};
-      running.run = run;
-      running.has_run = true;
-      ActivityScope scope(running);
-      try {
-        rec = run_one(g, inst, filters, opt.seed, run);
-      } catch (...) {
-        rethrow_from_plugin();  // names the run, the node and its plugin file
-      }
-    }
-    // Checked on every process, whichever runs the run, so the job behaves the same for any -np.
-    for (size_t i = 0; i < N; ++i)
-      if (rec.results[i] && !dynamic_cast<const RunResultCodec*>(inst.components[i].get()))
-        throw ConfigError("node '" + g.nodes[i].config.id + "' (" + g.nodes[i].config.type +
-                          ") returns per-run results that cannot be sent between the processes of an MPI job: its "
-                          "plugin does not implement trackflow::RunResultCodec (run_result_codec.hpp). Run this "
-                          "pipeline without mpirun (--threads N uses one machine's cores).");
-    return rec;
-  }
-  void save(const RunRecord& rec, std::uint64_t run, std::string& out) const {
-    ByteWriter w(out);
-    w.put(run);
-    w.put(rec.source_items);
-    w.put(rec.measurements_processed);
-    for (const auto* list : {&rec.diagnostics.skips, &rec.diagnostics.warnings}) {
-      w.put(static_cast<std::uint64_t>(list->size()));
-      for (const auto& e : *list) {
-        w.put_string(e.node);
-        w.put_string(e.message);
-      }
-    }
-    for (size_t i = 0; i < rec.results.size(); ++i) {
-      w.put(static_cast<std::uint8_t>(rec.results[i] ? 1 : 0));
-      if (rec.results[i])
-        dynamic_cast<const RunResultCodec&>(*inst.components[i]).save_run_result(*rec.results[i], w);
+// Checked on every process, whichever runs the run, so the job behaves the same for any -np.
+void check_codecs(const Graph& g, const GraphInstance& inst, const RunRecord& rec) {
+  for (size_t i = 0; i < g.nodes.size(); ++i)
+    if (rec.results[i] && !dynamic_cast<const RunResultCodec*>(inst.components[i].get()))
+      throw ConfigError("node '" + g.nodes[i].config.id + "' (" + g.nodes[i].config.type +
+                        ") returns per-run results that cannot be sent between the processes of an MPI job: its "
+                        "plugin does not implement trackflow::RunResultCodec (run_result_codec.hpp). Run this "
+                        "pipeline without mpirun (--threads N uses one machine's cores).");
+}
+
+void save_record(const RunRecord& rec, std::uint64_t run, const GraphInstance& inst, std::string& out) {
+  ByteWriter w(out);
+  w.put(run);
+  w.put(rec.source_items);
+  w.put(rec.measurements_processed);
+  for (const auto* list : {&rec.diagnostics.skips, &rec.diagnostics.warnings}) {
+    w.put(static_cast<std::uint64_t>(list->size()));
+    for (const auto& e : *list) {
+      w.put_string(e.node);
+      w.put_string(e.message);
     }
   }
-};
+  for (size_t i = 0; i < rec.results.size(); ++i) {
+    w.put(static_cast<std::uint8_t>(rec.results[i] ? 1 : 0));
+    if (rec.results[i]) dynamic_cast<const RunResultCodec&>(*inst.components[i]).save_run_result(*rec.results[i], w);
+  }
+}
 
 RunRecord load_record(ByteReader& in, const GraphInstance& aggregate) {
   RunRecord rec;
@@ -185,10 +158,10 @@ long long fingerprint(const Graph& g, const RunOptions& opt) {
 }
 
 // How many runs rank 0 hands out ahead of the oldest one not merged: four per thread of the job
-// (every process runs `threads`), as engine.cpp's window. TRACKFLOW_MPI_WINDOW=N sets it (tests
-// run with 1, where most requests wait for a merge); a value that is not a whole number from 1
-// to 10^12 - 1 is reported in the summary's warnings and the default used (rank 0 cannot stop here:
-// the other processes already wait for runs).
+// (every process runs `threads`), as the threaded engine's window. TRACKFLOW_MPI_WINDOW=N sets it
+// (tests run with 1, where most requests wait for a merge); a value that is not a whole number
+// from 1 to 10^12 - 1 is reported in the summary's warnings and the default used (rank 0 cannot
+// stop here: the other processes already wait for runs).
 std::uint64_t mpi_window(unsigned threads, int processes, std::vector<std::string>& warnings) {
   const std::uint64_t fallback = 4 * static_cast<std::uint64_t>(threads) * static_cast<std::uint64_t>(std::max(1, processes));
   if (const char* v = std::getenv("TRACKFLOW_MPI_WINDOW")) {
@@ -218,76 +191,124 @@ Failure decode(const std::string& s) {
   const char k = s[0];
   return {k == 'C' ? FailureKind::Config : k == 'I' ? FailureKind::Internal : FailureKind::Data, s.substr(1)};
 }
-[[noreturn]] void throw_failure(const Failure& f) {
-  if (f.kind == FailureKind::Config) throw ConfigError(f.message);
-  if (f.kind == FailureKind::Internal) throw InternalError(f.message);
-  throw DataError(f.message);
+std::exception_ptr as_error(const Failure& f) {
+  if (f.kind == FailureKind::Config) return std::make_exception_ptr(ConfigError(f.message));
+  if (f.kind == FailureKind::Internal) return std::make_exception_ptr(InternalError(f.message));
+  return std::make_exception_ptr(DataError(f.message));
 }
 
 // The failure of run `run` on `rank`. Errors from plugin code come through rethrow_from_plugin,
 // which names the node and the run already ("run R: node ..." for bad data, "node ... during
-// run R threw" for a bug): the run is added only where the message lacks it.
-Failure describe(int rank, std::uint64_t run, const std::exception& e) {
-  if (const auto* c = dynamic_cast<const ConfigError*>(&e)) return {FailureKind::Config, c->message()};
-  const std::string prefix = "run " + std::to_string(run) + ": ";
-  std::string what = e.what();
-  const bool names_run = what.rfind(prefix, 0) == 0 || what.find(" during run " + std::to_string(run) + " ") != std::string::npos;
-  if (!names_run) what = prefix + what;
-  if (dynamic_cast<const std::bad_alloc*>(&e))  // as one process reports it: exit 3
-    return {FailureKind::Internal, "rank " + std::to_string(rank) + ": " + prefix + "out of memory"};
-  const FailureKind kind = dynamic_cast<const InternalError*>(&e) ? FailureKind::Internal : FailureKind::Data;
-  return {kind, "rank " + std::to_string(rank) + ": " + what};
+// run R threw" for a bug): the run is added only where the message lacks it. A merge that fails
+// is described with the run merged, not the run just finished.
+Failure describe(int rank, std::uint64_t run, const std::exception_ptr& error) {
+  try {
+    std::rethrow_exception(error);
+  } catch (const ConfigError& c) {
+    return {FailureKind::Config, c.message()};
+  } catch (const std::exception& e) {
+    const std::string prefix = "run " + std::to_string(run) + ": ";
+    std::string what = e.what();
+    const bool names_run = what.rfind(prefix, 0) == 0 || what.find(" during run " + std::to_string(run) + " ") != std::string::npos;
+    if (!names_run) what = prefix + what;
+    if (dynamic_cast<const std::bad_alloc*>(&e))  // as one process reports it: exit 3
+      return {FailureKind::Internal, "rank " + std::to_string(rank) + ": " + prefix + "out of memory"};
+    const FailureKind kind = dynamic_cast<const InternalError*>(&e) ? FailureKind::Internal : FailureKind::Data;
+    return {kind, "rank " + std::to_string(rank) + ": " + what};
+  } catch (...) {
+    return {FailureKind::Data, "rank " + std::to_string(rank) + ": run " + std::to_string(run) + ": unknown error"};
+  }
 }
+
+// Ranks > 0: the runs rank 0 assigned to this process, for its worker threads, and their
+// results as messages for rank 0 (MPI is called from the main thread only: MPI_THREAD_FUNNELED).
+class AssignedRuns final : public RunSource {
+ public:
+  AssignedRuns(const Graph& g, int rank) : g_(g), rank_(rank) {}
+
+  std::optional<std::uint64_t> next_run() override {
+    std::unique_lock<std::mutex> lock(m_);
+    cv_work_.wait(lock, [&] { return shutdown_ || !queue_.empty(); });
+    if (queue_.empty()) return std::nullopt;
+    const std::uint64_t run = queue_.front();
+    queue_.pop_front();
+    return run;
+  }
+  void finished(std::uint64_t run, RunRecord&& rec, const GraphInstance& ran_on) override {
+    std::pair<int, std::string> msg{kResult, {}};
+    try {
+      check_codecs(g_, ran_on, rec);
+      save_record(rec, run, ran_on, msg.second);
+    } catch (...) {
+      return failed(run, std::current_exception());
+    }
+    post(std::move(msg));
+  }
+  void failed(std::optional<std::uint64_t> run, std::exception_ptr error) override {
+    if (!run) return;  // a thread without its instance fails each run it is given (named there)
+    std::pair<int, std::string> msg{kError, {}};
+    ByteWriter w(msg.second);
+    w.put(*run);
+    w.put_string(encode(describe(rank_, *run, error)));
+    post(std::move(msg));
+  }
+
+  void assign(const std::vector<std::uint64_t>& runs) {
+    {
+      std::lock_guard<std::mutex> lock(m_);
+      queue_.insert(queue_.end(), runs.begin(), runs.end());
+    }
+    cv_work_.notify_all();
+  }
+  void stop() {
+    {
+      std::lock_guard<std::mutex> lock(m_);
+      shutdown_ = true;
+    }
+    cv_work_.notify_all();
+  }
+  // The messages of finished runs: waits up to `timeout` for one (forever: none).
+  std::deque<std::pair<int, std::string>> outgoing(std::optional<std::chrono::microseconds> timeout) {
+    std::deque<std::pair<int, std::string>> ready;
+    std::unique_lock<std::mutex> lock(m_);
+    if (!timeout)
+      cv_out_.wait(lock, [&] { return !outbox_.empty(); });
+    else if (timeout->count() > 0)
+      cv_out_.wait_for(lock, *timeout, [&] { return !outbox_.empty(); });
+    ready.swap(outbox_);
+    return ready;
+  }
+
+ private:
+  void post(std::pair<int, std::string>&& msg) {
+    {
+      std::lock_guard<std::mutex> lock(m_);
+      outbox_.push_back(std::move(msg));
+    }
+    cv_out_.notify_one();
+  }
+  const Graph& g_;
+  const int rank_;
+  std::mutex m_;
+  std::condition_variable cv_work_, cv_out_;
+  std::deque<std::uint64_t> queue_;
+  std::deque<std::pair<int, std::string>> outbox_;  // (tag, payload)
+  bool shutdown_ = false;
+};
 
 // Ranks > 0: ask for runs, run them on opt.threads threads, send the results back.
 Outcome worker_rank(const Graph& g, const PluginRegistry& registry, const RunOptions& opt, mpi::communicator& world,
                     unsigned threads) {
   const MPI_Comm comm = world;
-  const int rank = world.rank();  // MPI is called from this thread only (MPI_THREAD_FUNNELED)
-  std::mutex m;
-  std::condition_variable cv_work, cv_out;
-  std::deque<std::uint64_t> queue;
-  std::deque<std::pair<int, std::string>> outbox;  // (tag, payload)
-  bool shutdown = false;
-  auto worker = [&]() {
-    prepare_thread_for_crash_reports();  // a stack overflow in a plugin is named here too
-    // As in engine.cpp: a sink that keeps a large run's rows in a temporary file asks
-    // output_directory() (none there, or none possible: they stay in memory).
-    OutputDirectoryScope dir(opt.output_dir);
-    std::unique_ptr<Runner> runner;
-    std::string setup_error;
-    try {
-      runner = std::make_unique<Runner>(g, registry, opt);
-    } catch (const std::exception& e) {
-      setup_error = e.what();
-    }
-    for (;;) {
-      std::uint64_t run;
-      {
-        std::unique_lock<std::mutex> lock(m);
-        cv_work.wait(lock, [&] { return shutdown || !queue.empty(); });
-        if (queue.empty()) return;
-        run = queue.front();
-        queue.pop_front();
-      }
-      std::pair<int, std::string> msg;
-      try {
-        if (!runner) throw DataError("could not build the pipeline on this process: " + setup_error);
-        RunRecord rec = runner->run(run);
-        msg.first = kResult;
-        runner->save(rec, run, msg.second);
-      } catch (const std::exception& e) {
-        msg = {kError, encode(describe(rank, run, e))};
-      }
-      {
-        std::lock_guard<std::mutex> lock(m);
-        outbox.push_back(std::move(msg));
-      }
-      cv_out.notify_one();
-    }
-  };
-  std::vector<std::thread> pool;
-  for (unsigned t = 0; t < threads; ++t) pool.emplace_back(worker);
+  const int rank = world.rank();
+  AssignedRuns source(g, rank);
+  WorkerPool pool(g, registry, opt, source);
+  // A process limit may leave fewer threads: the runs assigned here wait for them. None: this
+  // process cannot run the runs rank 0 would hand it, and rank 0 would wait for them forever.
+  if (const std::string short_of_threads = pool.start(threads); !short_of_threads.empty() && !pool.running()) {
+    std::fprintf(stderr, "trackflow: rank %d: %s; aborting the job\n", rank, short_of_threads.c_str());
+    MPI_Abort(comm, 3);
+  }
   std::uint64_t in_flight = 0;
   bool stop = false, asked = false;
   std::vector<std::uint64_t> assigned(threads);  // rank 0 answers a request with at most as many runs
@@ -314,32 +335,18 @@ Outcome worker_rank(const Graph& g, const PluginRegistry& registry, const RunOpt
           const std::vector<std::uint64_t> runs(assigned.begin(), assigned.begin() + count);
           asked = false;
           answered = true;
-          if (runs.empty()) {
-            stop = true;
-          } else {
-            {
-              std::lock_guard<std::mutex> lock(m);
-              queue.insert(queue.end(), runs.begin(), runs.end());
-            }
-            in_flight += runs.size();
-            cv_work.notify_all();
-          }
+          if (runs.empty()) stop = true;
+          source.assign(runs);
+          in_flight += runs.size();
         }
       }
       if (in_flight == 0 && stop && !asked) break;
-      std::deque<std::pair<int, std::string>> ready;
-      {
-        std::unique_lock<std::mutex> lock(m);
-        if (answered) {
-          // free threads may ask again at once
-        } else if (asked) {  // an answer may come: look again soon
-          cv_out.wait_for(lock, std::chrono::microseconds(200), [&] { return !outbox.empty(); });
-        } else {  // every thread busy (or stopping): only a finished run can come
-          cv_out.wait(lock, [&] { return !outbox.empty(); });
-        }
-        ready.swap(outbox);
-      }
-      for (auto& [tag, payload] : ready) {
+      // Answered: free threads may ask again at once. Asked: an answer may come, look again soon.
+      // Otherwise every thread is busy (or stopping): only a finished run can come.
+      using std::chrono::microseconds;
+      const auto ready = source.outgoing(answered ? std::optional<microseconds>(microseconds(0))
+                                                  : asked ? std::optional<microseconds>(microseconds(200)) : std::nullopt);
+      for (const auto& [tag, payload] : ready) {
         send_bytes(comm, 0, tag, payload);
         --in_flight;
         if (tag == kError) stop = true;  // no new runs; what is in flight still reports
@@ -351,199 +358,150 @@ Outcome worker_rank(const Graph& g, const PluginRegistry& registry, const RunOpt
     MPI_Abort(comm, 3);
     throw;
   }
-  {
-    std::lock_guard<std::mutex> lock(m);
-    shutdown = true;
-  }
-  cv_work.notify_all();
-  for (auto& t : pool) t.join();
+  source.stop();
+  pool.join();
   send_u64(comm, 0, kDone, 0);
   if (recv_u64(comm, 0, kFinal) != 0) throw ReportedElsewhere();
   return empty_outcome(g, opt.runs);
 }
 
-// Rank 0: hands out runs, runs some itself, merges everything in run order.
-Outcome root_rank(const Graph& g, const PluginRegistry& registry, const RunOptions& opt, mpi::communicator& world,
-                  unsigned threads) {
-  const MPI_Comm comm = world;
-  const std::uint64_t runs = opt.runs;
-  Outcome out = empty_outcome(g, runs);
-  GraphInstance aggregate = instantiate(g, registry);
-  // Results received from the other processes are loaded and merged on this thread, and finish()
-  // runs here: streaming sinks (sink.csv) write into --out as they merge, as in engine.cpp.
-  OutputDirectoryScope dir(opt.output_dir);
-
-  // Handing out runs: in order, to whoever asks (its own threads and the other processes), at most
-  // `window` runs ahead of the oldest one not yet merged, as engine.cpp's workers: finished runs
-  // wait on this process until every earlier run is merged, so a slow run must not let them pile
-  // up without bound. A request the window holds back is answered when the window moves.
-  std::mutex dispense_mutex;
-  std::uint64_t next_run = 0;
-  std::atomic<std::uint64_t> merged_runs{0};
-  const std::uint64_t window = mpi_window(threads, world.size(), out.warnings);
-  std::atomic<bool> failed{false};
-  Failure failure;
-  bool has_failure = false;
-  std::condition_variable window_moved;  // rank 0's own threads wait on it (with merge_mutex)
-  auto fail = [&](Failure f) {
-    {
-      std::lock_guard<std::mutex> lock(dispense_mutex);
-      if (!has_failure) {
-        failure = std::move(f);
-        has_failure = true;
-      }
-      failed = true;
-    }
-    window_moved.notify_all();
-  };
-  auto take = [&](std::uint64_t n) {
-    std::vector<std::uint64_t> out_runs;
-    std::lock_guard<std::mutex> lock(dispense_mutex);
-    const std::uint64_t merged = merged_runs.load();
-    const std::uint64_t limit = window >= runs - std::min(merged, runs) ? runs : merged + window;
-    while (!failed && next_run < runs && next_run < limit && out_runs.size() < n) out_runs.push_back(next_run++);
-    return out_runs;
-  };
-  // No run will be handed out any more (all are, or the job failed).
-  auto exhausted = [&] {
-    std::lock_guard<std::mutex> lock(dispense_mutex);
-    return failed || next_run >= runs;
-  };
-
-  // Merging in run order, as engine.cpp does, whichever thread or process ran the run.
-  const NodeLabels aggregate_labels = labels_of(g, aggregate);
-  RunOrderMerge merger(aggregate, aggregate_labels, runs, out);
-  std::mutex merge_mutex;
-  // A merge that fails names its node and run (rethrow_from_plugin), not the run just finished.
-  auto complete = [&](std::uint64_t run, RunRecord&& rec) {
+// Rank 0's own threads: runs from the dispatcher, results checked as on every other process.
+class RankZeroRuns final : public RunSource {
+ public:
+  RankZeroRuns(const Graph& g, RunDispatcher& d) : g_(g), d_(d) {}
+  std::optional<std::uint64_t> next_run() override { return d_.next_run(); }
+  void finished(std::uint64_t run, RunRecord&& rec, const GraphInstance& ran_on) override {
     try {
-      std::lock_guard<std::mutex> lock(merge_mutex);
-      merger.complete(run, std::move(rec));
-      merged_runs = merger.merged();
-      window_moved.notify_all();
-    } catch (const ConfigError& e) {
-      fail({FailureKind::Config, e.message()});
-    } catch (const std::bad_alloc&) {
-      fail({FailureKind::Internal, "rank 0: run " + std::to_string(run) + ": out of memory"});
+      check_codecs(g_, ran_on, rec);
+    } catch (...) {
+      return d_.failed(run, std::current_exception());
+    }
+    d_.finished(run, std::move(rec), ran_on);
+  }
+  void failed(std::optional<std::uint64_t> run, std::exception_ptr error) override { d_.failed(run, error); }
+
+ private:
+  const Graph& g_;
+  RunDispatcher& d_;
+};
+
+// Rank 0: hands the dispatcher's runs to its own threads and to the other processes as they ask
+// (a request the window holds back is answered when it moves), and gives their results back.
+class MpiRanks final : public Transport {
+ public:
+  MpiRanks(const Graph& g, const PluginRegistry& registry, const RunOptions& opt, mpi::communicator& world,
+           unsigned threads, const GraphInstance& aggregate)
+      : g_(g), registry_(registry), opt_(opt), world_(world), threads_(threads), aggregate_(aggregate) {}
+
+  std::uint64_t window(std::vector<std::string>& warnings) override { return mpi_window(threads_, world_.size(), warnings); }
+
+  std::exception_ptr attribute(std::optional<std::uint64_t> run, std::exception_ptr error) const override {
+    if (run) return as_error(describe(0, *run, error));
+    try {
+      std::rethrow_exception(error);
     } catch (const std::exception& e) {
-      fail({dynamic_cast<const InternalError*>(&e) ? FailureKind::Internal : FailureKind::Data,
-            std::string("rank 0: ") + e.what()});
+      return std::make_exception_ptr(DataError(std::string("rank 0: ") + e.what()));
+    } catch (...) {
+      return std::make_exception_ptr(DataError("rank 0: unknown error"));
     }
-  };
+  }
 
-  std::atomic<unsigned> active{threads};
-  auto worker = [&]() {
-    prepare_thread_for_crash_reports();
-    OutputDirectoryScope dir(opt.output_dir);  // merges happen here too: sink.csv streams its file
+  void carry(RunDispatcher& d) override {
+    const MPI_Comm comm = world_;
+    RankZeroRuns own(g_, d);
+    WorkerPool pool(g_, registry_, opt_, own);
+    // Under a process limit rank 0 may run fewer threads or none: the other processes run the rest.
+    if (const std::string short_of_threads = pool.start(threads_); !short_of_threads.empty()) d.warn(short_of_threads);
+    int running_ranks = world_.size() - 1;
+    std::deque<std::pair<int, std::uint64_t>> held_back;  // requests (rank, runs) the window holds back
     try {
-      Runner runner(g, registry, opt);
-      for (;;) {
-        const auto mine = take(1);
-        if (mine.empty()) {
-          if (exhausted()) break;
-          std::unique_lock<std::mutex> lock(merge_mutex);  // the window is full: wait for a merge
-          window_moved.wait_for(lock, std::chrono::milliseconds(10));
+      while (running_ranks > 0 || pool.running()) {
+        while (!held_back.empty()) {
+          const auto given = d.take(held_back.front().second);
+          if (given.empty() && !d.exhausted()) break;
+          send_runs(comm, held_back.front().first, given);
+          held_back.pop_front();
+        }
+        int flag = 0;
+        MPI_Status st;
+        MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, comm, &flag, &st);
+        if (flag) {
+          receive(d, st.MPI_SOURCE, st.MPI_TAG, held_back, running_ranks);
           continue;
         }
+        d.show_progress();
+        std::this_thread::sleep_for(std::chrono::microseconds(50));
+      }
+    } catch (const std::exception& e) {
+      // An MPI failure mid-exchange: the other processes would wait for rank 0 forever.
+      std::fprintf(stderr, "trackflow: rank 0: the MPI exchange failed (%s); aborting the job\n", e.what());
+      MPI_Abort(comm, 3);
+      throw;
+    }
+    pool.join();
+    const std::uint64_t status = d.has_failed() ? 1 : 0;
+    for (int r = 1; r < world_.size(); ++r) send_u64(comm, r, kFinal, status);
+  }
+
+ private:
+  void receive(RunDispatcher& d, int src, int tag, std::deque<std::pair<int, std::uint64_t>>& held_back, int& running_ranks) {
+    const MPI_Comm comm = world_;
+    switch (tag) {
+      case kRequest: {
+        const std::uint64_t n = recv_u64(comm, src, kRequest);
+        const auto given = d.take(n);
+        if (!given.empty() || d.exhausted())
+          send_runs(comm, src, given);  // none: stop
+        else
+          held_back.emplace_back(src, n);
+        return;
+      }
+      case kResult: {
+        const std::string bytes = recv_bytes(comm, src, kResult);
+        ByteReader in(bytes.data(), bytes.size());
+        std::uint64_t run = 0;
         RunRecord rec;
         try {
-          rec = runner.run(mine[0]);
+          run = in.get<std::uint64_t>();
+          rec = load_record(in, aggregate_);  // the codecs are const: no lock needed
         } catch (const std::exception& e) {
-          fail(describe(0, mine[0], e));
-          continue;
+          d.failed_elsewhere(run, std::make_exception_ptr(DataError("rank " + std::to_string(src) + ": run " +
+                                                                    std::to_string(run) + ": " + e.what())));
+          return;
         }
-        complete(mine[0], std::move(rec));
+        d.complete(run, std::move(rec));
+        return;
       }
-    } catch (const std::exception& e) {
-      fail({FailureKind::Data, std::string("rank 0: ") + e.what()});
+      case kError: {
+        const std::string bytes = recv_bytes(comm, src, kError);
+        ByteReader in(bytes.data(), bytes.size());
+        const auto run = in.get<std::uint64_t>();
+        d.failed_elsewhere(run, as_error(decode(in.get_string())));
+        return;
+      }
+      case kDone:
+        recv_u64(comm, src, kDone);
+        --running_ranks;
+        return;
+      default:
+        throw std::runtime_error("unexpected MPI message tag " + std::to_string(tag) + " from rank " + std::to_string(src));
     }
-    --active;
-  };
-
-  const auto t0 = std::chrono::steady_clock::now();
-  std::vector<std::thread> pool;
-  for (unsigned t = 0; t < threads; ++t) pool.emplace_back(worker);
-  int running_ranks = world.size() - 1;
-  std::deque<std::pair<int, std::uint64_t>> held_back;  // requests (rank, runs) the window holds back
-  auto last_progress = std::chrono::steady_clock::now();
-  try {
-    while (running_ranks > 0 || active.load() > 0) {
-      while (!held_back.empty()) {
-        const auto given = take(held_back.front().second);
-        if (given.empty() && !exhausted()) break;
-        send_runs(comm, held_back.front().first, given);
-        held_back.pop_front();
-      }
-      int flag = 0;
-      MPI_Status st;
-      MPI_Iprobe(MPI_ANY_SOURCE, MPI_ANY_TAG, comm, &flag, &st);
-      if (flag) {
-        const int src = st.MPI_SOURCE;
-        switch (st.MPI_TAG) {
-          case kRequest: {
-            const std::uint64_t n = recv_u64(comm, src, kRequest);
-            const auto given = take(n);
-            if (!given.empty() || exhausted())
-              send_runs(comm, src, given);  // none: stop
-            else
-              held_back.emplace_back(src, n);
-            break;
-          }
-          case kResult: {
-            const std::string bytes = recv_bytes(comm, src, kResult);
-            ByteReader in(bytes.data(), bytes.size());
-            std::uint64_t run = 0;
-            RunRecord rec;
-            try {
-              run = in.get<std::uint64_t>();
-              rec = load_record(in, aggregate);  // the codecs are const: no lock needed
-            } catch (const std::exception& e) {
-              fail({FailureKind::Data, "rank " + std::to_string(src) + ": run " + std::to_string(run) + ": " + e.what()});
-              break;
-            }
-            complete(run, std::move(rec));
-            break;
-          }
-          case kError:
-            fail(decode(recv_bytes(comm, src, kError)));
-            break;
-          case kDone:
-            recv_u64(comm, src, kDone);
-            --running_ranks;
-            break;
-          default:
-            throw std::runtime_error("unexpected MPI message tag " + std::to_string(st.MPI_TAG) + " from rank " +
-                                     std::to_string(src));
-        }
-        continue;
-      }
-      if (opt.progress && std::chrono::steady_clock::now() - last_progress > std::chrono::milliseconds(100)) {
-        std::uint64_t merged;
-        {
-          std::lock_guard<std::mutex> lock(merge_mutex);
-          merged = merger.merged();
-        }
-        opt.progress(merged, runs);
-        last_progress = std::chrono::steady_clock::now();
-      }
-      std::this_thread::sleep_for(std::chrono::microseconds(50));
-    }
-  } catch (const std::exception& e) {
-    // An MPI failure mid-exchange: the other processes would wait for rank 0 forever.
-    std::fprintf(stderr, "trackflow: rank 0: the MPI exchange failed (%s); aborting the job\n", e.what());
-    MPI_Abort(comm, 3);
-    throw;
   }
-  for (auto& t : pool) t.join();
-  const int status = failed ? 1 : 0;
-  for (int r = 1; r < world.size(); ++r) send_u64(comm, r, kFinal, static_cast<std::uint64_t>(status));
-  if (failed) throw_failure(failure);
-  if (merger.merged() != runs) throw std::runtime_error("distributed run ended with " + std::to_string(merger.merged()) + " of " +
-                                                   std::to_string(runs) + " runs merged");
-  if (opt.progress) opt.progress(runs, runs);
-  out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  finish_all(g, aggregate, aggregate_labels, opt, runs, out);
-  return out;
+
+  const Graph& g_;
+  const PluginRegistry& registry_;
+  const RunOptions& opt_;
+  mpi::communicator& world_;
+  const unsigned threads_;
+  const GraphInstance& aggregate_;
+};
+
+// Rank 0: the dispatcher over the MPI ranks; it merges everything in run order.
+Outcome root_rank(const Graph& g, const PluginRegistry& registry, const RunOptions& opt, mpi::communicator& world,
+                  unsigned threads) {
+  GraphInstance aggregate = instantiate(g, registry);
+  MpiRanks transport(g, registry, opt, world, threads, aggregate);
+  return dispatch_ensemble(g, aggregate, opt, opt.runs, transport);
 }
 
 }  // namespace

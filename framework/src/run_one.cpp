@@ -141,29 +141,22 @@ void merge_run_diagnostics(const RunRecord& rec, std::uint64_t run, std::uint64_
     if (out.warnings.size() < 20) out.warnings.push_back(w.node + ": " + w.message);
 }
 
-void RunOrderMerge::complete(std::uint64_t run, RunRecord&& rec) {
-  if (failed_) return;
-  pending_.emplace(run, std::move(rec));
-  for (auto it = pending_.find(next_); it != pending_.end(); it = pending_.find(next_)) {
-    Activity merging{"merging the results of a run", &labels_};
-    merging.run = it->first;
-    merging.has_run = true;
-    ActivityScope scope(merging);
-    try {
-      for (size_t i = 0; i < it->second.results.size(); ++i)
-        if (it->second.results[i]) {
-          detail::executing = aggregate_.components[i].get();
-          aggregate_.components[i]->merge(*it->second.results[i]);
-        }
-    } catch (...) {
-      failed_ = true;
-      pending_.clear();
-      rethrow_from_plugin();
-    }
-    merge_run_diagnostics(it->second, it->first, runs_, out_);
-    pending_.erase(it);
-    ++next_;
+void merge_run(GraphInstance& aggregate, const NodeLabels& labels, std::uint64_t run, std::uint64_t runs,
+               RunRecord&& rec, Outcome& out) {
+  Activity merging{"merging the results of a run", &labels};
+  merging.run = run;
+  merging.has_run = true;
+  ActivityScope scope(merging);
+  try {
+    for (size_t i = 0; i < rec.results.size(); ++i)
+      if (rec.results[i]) {
+        detail::executing = aggregate.components[i].get();
+        aggregate.components[i]->merge(*rec.results[i]);
+      }
+  } catch (...) {
+    rethrow_from_plugin();
   }
+  merge_run_diagnostics(rec, run, runs, out);
 }
 
 void finish_all(const Graph& g, GraphInstance& aggregate, const NodeLabels& labels, const RunOptions& opt,

@@ -1,4 +1,4 @@
-// Purpose: one Monte Carlo run on one graph instance — the engine's and the MPI engine's shared step: resets, start_run, the time-ordered merge of the sources, end_run — and the merge of its counts and diagnostics into the Outcome.
+// Purpose: one Monte Carlo run on one graph instance — the engine's and the MPI engine's shared step: resets, start_run, the time-ordered merge of the sources, end_run — and the merge of one run into the ensemble's results.
 #pragma once
 
 #include <trackflow/component.hpp>
@@ -7,7 +7,6 @@
 #include <trackflow/host/guard.hpp>
 
 #include <cstdint>
-#include <map>
 #include <memory>
 #include <vector>
 
@@ -42,32 +41,12 @@ RunRecord run_one(const Graph& g, GraphInstance& inst, const std::vector<Filter*
 // run when there is more than one; at most 20 warnings in all). Call in run order.
 void merge_run_diagnostics(const RunRecord& rec, std::uint64_t run, std::uint64_t runs, Outcome& out);
 
-// The ordered reduction of both engines: a finished run waits until every earlier one is merged,
-// then its per-run results go to the aggregating instance's merge() and its counts and
-// diagnostics into the Outcome -- strictly in run order, so sums are identical for any thread or
-// process count. Not thread-safe: callers hold their lock. A plugin that throws in merge() is
-// reported with its node and that run (rethrow_from_plugin); the crash handler names them too.
-class RunOrderMerge {
- public:
-  RunOrderMerge(GraphInstance& aggregate, const NodeLabels& labels, std::uint64_t runs, Outcome& out)
-      : aggregate_(aggregate), labels_(labels), runs_(runs), out_(out) {}
-  RunOrderMerge(GraphInstance&, NodeLabels&&, std::uint64_t, Outcome&) = delete;  // it keeps the labels
-  // Adds run `run` and merges every run that is now next in order. After a merge() has thrown,
-  // runs are dropped: merging the failed run again would repeat the earlier nodes' merges (a
-  // sink's rows written twice) for a job that fails anyway.
-  void complete(std::uint64_t run, RunRecord&& rec);
-  // How many runs are merged (the next one to merge).
-  std::uint64_t merged() const { return next_; }
-
- private:
-  GraphInstance& aggregate_;
-  const NodeLabels& labels_;
-  const std::uint64_t runs_;
-  Outcome& out_;
-  std::map<std::uint64_t, RunRecord> pending_;
-  std::uint64_t next_ = 0;
-  bool failed_ = false;
-};
+// Merges run `run` of `runs` into the ensemble: its per-run results into the aggregating
+// instance's merge(), its counts and diagnostics into the Outcome. The dispatcher calls it in run
+// order, so sums are identical for any thread or process count. A plugin that throws in merge()
+// is reported with its node and that run (rethrow_from_plugin); the crash handler names them too.
+void merge_run(GraphInstance& aggregate, const NodeLabels& labels, std::uint64_t run, std::uint64_t runs,
+               RunRecord&& rec, Outcome& out);
 
 // finish() of every node of the aggregating instance, on the calling thread, in graph order;
 // a plugin that throws is reported with its node (rethrow_from_plugin).
