@@ -9,6 +9,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "estimation/radar_filter_test_support.hpp"
 #include "plugin_fixture.hpp"
 
 using namespace trackflow;
@@ -20,28 +21,11 @@ constexpr double kSigmaRange = 15.0, kSigmaAngle = 3e-3;
 const char* const kGt = "{ singer_alpha: 1 1/s, singer_sigma: 20 m/s2 }";
 const char* const kEkf = "{ motion: singer, singer_alpha: 1 1/s, singer_sigma: 20 m/s2 }";
 
-// A radar measurement built with geometry.hpp only.
+// A radar measurement built with geometry.hpp only (the Cartesian filters' shared test helper).
 Measurement radar(double t, const Vec3& pos, const Vec3& sensor, Rng* rng,
                   AzimuthConvention c = AzimuthConvention::NorthClockwise, bool with_rr = false,
                   const Vec3& vel = Vec3::Zero()) {
-  Measurement m;
-  m.time = t;
-  m.frame = Frame::Spherical;
-  m.azimuth = c;
-  m.sensor_position = sensor;
-  m.has_range_rate = with_rr;
-  const int n = with_rr ? 4 : 3;
-  m.value.resize(n);
-  m.value.head<3>() = enu_to_spherical(pos - sensor, c);
-  if (with_rr) m.value(3) = range_rate(pos - sensor, vel);
-  m.covariance = MeasCov::Zero(n, n);
-  const double sig[4] = {kSigmaRange, kSigmaAngle, kSigmaAngle, 1.0};
-  for (int i = 0; i < n; ++i) {
-    m.covariance(i, i) = sig[i] * sig[i];
-    if (rng) m.value(i) += sig[i] * rng->normal();
-  }
-  m.value(1) = wrap_angle(m.value(1));
-  return m;
+  return filter_test::radar(t, pos, vel, sensor, {kSigmaRange, kSigmaAngle, kSigmaAngle, 1.0}, rng, with_rr, c);
 }
 
 // Paper 002 scenario (1): circle of 1500 m radius at 150 m altitude, 200 m/s, radar at its centre.
