@@ -4,7 +4,7 @@
 #   e.g. bench/number_format.sh /work/main/build/bin/trackflow build/bin/trackflow 3
 # CPU seconds (user + sys, GNU time) of each command, the median of REPEATS, the builds alternating
 # so other load on the machine affects both alike; single thread. Also checks that both builds
-# write the same report.html (apart from the version line) and the same sink.csv file.
+# write the same report.html (apart from --out and the elapsed time), series CSVs and sink.csv file.
 #   report: `trackflow report` minus `trackflow run` of pipelines/launch_normal_noise.yaml
 #     (10 runs x 21 600 steps, 4 filters): the series CSVs, the track and the HTML page.
 #   sink.csv: pipelines/quickstart.yaml with a sink.csv node on the filter and the truth (200 x
@@ -56,9 +56,12 @@ for b in old new; do
   per_row=$(awk -v c="$(m $b.csv)" -v p="$(m $b.plain)" -v rows="$rows" 'BEGIN { printf "%.2f us", 1e6 * (c - p) / rows }')
   echo "$b: the report adds $extra; sink.csv costs $per_row per row"
 done
-grep -v 'trackflow [0-9]' "$OUT/old.report/report.html" > "$OUT/old.html"
-grep -v 'trackflow [0-9]' "$OUT/new.report/report.html" > "$OUT/new.html"
-cmp -s "$OUT/old.html" "$OUT/new.html" && echo "report.html: identical (apart from the version line)" || echo "report.html: DIFFERS"
+# The page names its --out folder and the run's elapsed seconds; everything else must match.
+for b in old new; do
+  sed -E "s#$OUT/$b\.report#OUT#g; s/[0-9.]+ s; ([0-9]+ measurements processed)/T s; \1/" "$OUT/$b.report/report.html" > "$OUT/$b.html"
+done
+cmp -s "$OUT/old.html" "$OUT/new.html" && echo "report.html: identical (apart from --out and the elapsed time)" ||
+  echo "report.html: DIFFERS"
 cmp -s "$OUT/old.csv/log.csv" "$OUT/new.csv/log.csv" && echo "log.csv: identical" || echo "log.csv: DIFFERS"
 diff -r -q -x report.html "$OUT/old.report" "$OUT/new.report" > /dev/null && echo "series and track CSVs: identical" ||
   echo "series and track CSVs: DIFFER"

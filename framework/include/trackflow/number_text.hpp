@@ -9,9 +9,10 @@
 
 // std::to_chars is specified to give exactly what printf gives for the same format and
 // precision (C++17 [charconv.to.chars]: "as if by printf in the C locale"), but without
-// printf's format parsing, locale and multi-precision arithmetic: a CSV row of doubles costs a
-// fifth. Non-finite values come out as printf writes them ("inf", "-inf", "nan", "-nan"); most
-// callers decide themselves what a NaN becomes before calling these.
+// printf's format parsing, locale and multi-precision arithmetic: a number costs a quarter to a
+// fifth of snprintf's time (docs/performance.md, "Number formatting"). Non-finite values come
+// out as printf writes them ("inf", "-inf", "nan", "-nan"); most callers decide themselves what
+// a NaN becomes before calling these.
 namespace trackflow::number_text {
 
 namespace detail {
