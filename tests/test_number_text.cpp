@@ -92,7 +92,7 @@ std::vector<double> awkward_values() {
 
 }  // namespace
 
-TEST_CASE("number_text: general equals snprintf %.*g for every value and precision") {
+TEST_CASE("number_text: general equals snprintf %.*g, all precisions") {
   const auto values = awkward_values();
   long compared = 0;
   for (int precision : {0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15, 16, 17, 20, 25, 40, -1})
@@ -105,7 +105,7 @@ TEST_CASE("number_text: general equals snprintf %.*g for every value and precisi
   CHECK(compared > 1000000);
 }
 
-TEST_CASE("number_text: fixed equals snprintf %.*f, also beyond the stack buffer") {
+TEST_CASE("number_text: fixed equals snprintf %.*f, also long texts") {
   const auto values = awkward_values();
   for (int precision : {0, 1, 2, 3, 4, 6, 10, 17, 30})
     for (double v : values) {
@@ -118,7 +118,7 @@ TEST_CASE("number_text: fixed equals snprintf %.*f, also beyond the stack buffer
   CHECK(nt::fixed(-std::numeric_limits<double>::max(), 2).size() == 313);  // sign, 309 digits, point, 2
 }
 
-TEST_CASE("number_text: non-finite values are spelt as printf spells them") {
+TEST_CASE("number_text: non-finite values spelt as printf spells them") {
   const double inf = std::numeric_limits<double>::infinity(), nan = std::numeric_limits<double>::quiet_NaN();
   CHECK(nt::general(inf, 10) == "inf");
   CHECK(nt::general(-inf, 10) == "-inf");
@@ -129,7 +129,7 @@ TEST_CASE("number_text: non-finite values are spelt as printf spells them") {
   CHECK(nt::shortest(nan) == "nan");
 }
 
-TEST_CASE("number_text: shortest reads back exactly and is never longer than %.17g") {
+TEST_CASE("number_text: shortest round-trips, no longer than %.17g") {
   for (double v : awkward_values()) {
     if (std::isnan(v)) continue;
     const std::string s = nt::shortest(v);
