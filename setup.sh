@@ -74,7 +74,7 @@ case "$mode" in
     ctest --test-dir "$BUILD" -j2 --output-on-failure --timeout 900
     ;;
   bench)
-    echo "== built: $BUILD/bin/trackflow-bench, trackflow-bench-filters, trackflow-bench-gain-transform (docs/performance.md)"
+    echo "== built: $BUILD/bin/trackflow-bench, trackflow-bench-filters, trackflow-bench-gain-transform, trackflow-bench-csv (docs/performance.md)"
     ;;
   sanitize)
     # A report stops the process with exit code 86, which no test expects. ASan and LSan reports

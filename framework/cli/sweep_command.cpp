@@ -8,6 +8,7 @@
 #include <trackflow/host/report.hpp>
 #include <trackflow/host/suggest.hpp>
 #include <trackflow/host/sweep.hpp>
+#include <trackflow/number_text.hpp>
 #include <trackflow/units.hpp>
 
 #include <unistd.h>
@@ -51,9 +52,7 @@ struct MetricRef {
 
 std::string cell(double v) {
   if (!std::isfinite(v)) return "";
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return buf;
+  return number_text::general(v, 6);
 }
 
 // An axis' values in SI when its parameter is a real or an integer ("5 m" -> 5, "20 km" ->

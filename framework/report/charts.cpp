@@ -1,11 +1,13 @@
 // Purpose: Vega-Lite specs of the report's plots, built as JSON values.
 #include "charts.hpp"
 
+#include <trackflow/number_text.hpp>
+
 #include <algorithm>
+#include <charconv>
 #include <cmath>
-#include <cstdio>
-#include <cstdlib>
 #include <limits>
+#include <string>
 
 namespace trackflow::report {
 namespace {
@@ -57,9 +59,11 @@ bool all_positive(const std::vector<Line>& lines) {
 
 double round6(double v) {
   if (!std::isfinite(v) || v == 0.0) return v;
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.6g", v);
-  return std::strtod(buf, nullptr);
+  // Shorter than 16 characters: the string stays in its own small buffer, no allocation.
+  const std::string text = number_text::general(v, 6);
+  double rounded = v;
+  std::from_chars(text.data(), text.data() + text.size(), rounded);  // correctly rounded, as strtod
+  return rounded;
 }
 
 Chart line_chart(const std::string& title, const std::string& x_title, const std::string& y_title,

@@ -1,8 +1,9 @@
 // Purpose: CSV quoting, number cells and unit-carrying column names.
 #include "csv_text.hpp"
 
+#include <trackflow/number_text.hpp>
+
 #include <cmath>
-#include <cstdio>
 
 namespace trackflow::report {
 
@@ -18,9 +19,7 @@ std::string csv_field(const std::string& s) {
 
 std::string csv_number(double v, int digits) {
   if (!std::isfinite(v)) return {};
-  char buf[48];
-  std::snprintf(buf, sizeof buf, "%.*g", digits, v);
-  return buf;
+  return number_text::general(v, digits);
 }
 
 std::string unit_suffix(const std::string& unit) {

@@ -5,12 +5,12 @@
 #include "pipeline_layout.hpp"
 #include "report_assets.hpp"
 
+#include <trackflow/number_text.hpp>
 #include <trackflow/version.hpp>
 
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
-#include <cstdio>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -37,9 +37,7 @@ std::string esc(const std::string& s) {
 
 std::string num(double v) {
   if (!std::isfinite(v)) return std::isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf");
-  char buf[40];
-  std::snprintf(buf, sizeof buf, "%.5g", v);
-  return buf;
+  return number_text::general(v, 5);
 }
 
 // A parameter value as the analyst wrote it, in YAML flow style.

@@ -1,13 +1,13 @@
 // Purpose: expect checks, the terminal summary and the metrics JSON file.
 #include <trackflow/host/report.hpp>
 #include <trackflow/host/suggest.hpp>
+#include <trackflow/number_text.hpp>
 
 #include <nlohmann/json.hpp>
 
 #include <cerrno>
 #include <cmath>
 #include <cstring>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
@@ -18,13 +18,8 @@ namespace {
 
 std::string fmt(double v) {
   if (!std::isfinite(v)) return std::isnan(v) ? "nan" : (v > 0 ? "inf" : "-inf");
-  char buf[64];
   const double a = std::fabs(v);
-  if (a != 0.0 && (a >= 1e7 || a < 1e-3))
-    std::snprintf(buf, sizeof buf, "%.4g", v);
-  else
-    std::snprintf(buf, sizeof buf, "%.4f", v);
-  std::string s = buf;
+  std::string s = a != 0.0 && (a >= 1e7 || a < 1e-3) ? number_text::general(v, 4) : number_text::fixed(v, 4);
   if (s.find('.') != std::string::npos && s.find('e') == std::string::npos) {
     while (s.back() == '0') s.pop_back();
     if (s.back() == '.') s.pop_back();

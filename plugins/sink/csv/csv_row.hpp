@@ -1,9 +1,10 @@
-// Purpose: appends CSV cells to a reused string buffer: "%.*g" numbers, empty cells for missing values, "nan"/"inf" (counted) for non-finite ones.
+// Purpose: appends CSV cells to a reused string buffer: "%.*g" numbers (std::to_chars), empty cells for missing values, "nan"/"inf" (counted) for non-finite ones.
 #pragma once
+
+#include <trackflow/number_text.hpp>
 
 #include <cmath>
 #include <cstdint>
-#include <cstdio>
 #include <string>
 #include <string_view>
 
@@ -22,9 +23,7 @@ class RowWriter {
       if (non_finite_++ == 0) first_non_finite_ = column_;
       return;
     }
-    char buf[40];
-    const int n = std::snprintf(buf, sizeof buf, "%.*g", precision_, v);
-    out_.append(buf, static_cast<size_t>(n));
+    number_text::append_general(out_, v, precision_);
   }
   void real_if(bool present, double v) {
     if (present)
@@ -34,9 +33,7 @@ class RowWriter {
   }
   void integer(std::uint64_t v) {
     separate();
-    char buf[24];
-    const int n = std::snprintf(buf, sizeof buf, "%llu", static_cast<unsigned long long>(v));
-    out_.append(buf, static_cast<size_t>(n));
+    number_text::append_unsigned(out_, v);
   }
   void text(std::string_view s) {
     separate();

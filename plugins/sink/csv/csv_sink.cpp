@@ -463,9 +463,7 @@ class CsvSink final : public Component, public RunResultCodec {
     if (r.port >= 0 && static_cast<size_t>(r.port) < sources_.size()) {
       w.text(sources_[static_cast<size_t>(r.port)]);
     } else {
-      char name[24];
-      std::snprintf(name, sizeof name, "input%d", r.port);  // set_inputs was not called (direct use)
-      w.text(name);
+      w.text("input" + std::to_string(r.port));  // set_inputs was not called (direct use)
     }
     w.text(r.measurement ? "measurement" : "estimate");
     if (r.measurement)
@@ -505,9 +503,7 @@ class CsvSink final : public Component, public RunResultCodec {
     ++row_count_;
     if (w.non_finite()) {
       if (non_finite_ == 0) {
-        char t_text[40];
-        std::snprintf(t_text, sizeof t_text, "%.10g", r.time);
-        first_non_finite_ = "run " + std::to_string(run_) + ", t=" + t_text + " s, column " +
+        first_non_finite_ = "run " + std::to_string(run_) + ", t=" + number_text::general(r.time, 10) + " s, column " +
                             column_name(w.first_non_finite_column(), annotation_columns_, full_covariance_);
       }
       non_finite_ += static_cast<std::uint64_t>(w.non_finite());
