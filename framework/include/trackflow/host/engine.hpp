@@ -40,8 +40,9 @@ struct Outcome {
 
 // Same seed and same graph give the same Outcome (and the same files) for any thread count:
 // every node's random stream derives from (seed, run, node id), and per-run results are
-// merged in run order. Exceptions from a run stop the ensemble and are rethrown, with the
-// run number, as DataError.
+// merged in run order (framework/src/run_dispatcher.hpp, shared with the MPI engine). An
+// exception from a run stops the ensemble: no later run is handed out, and the lowest-numbered
+// failing run's exception is rethrown with its run number, as DataError, whatever the timing.
 Outcome run_graph(const Graph& g, const PluginRegistry& registry, const RunOptions& opt);
 
 }  // namespace trackflow::host
