@@ -3,6 +3,7 @@
 #include "sigma_spherical.hpp"
 #include "unscented_transform.hpp"
 
+#include <trackflow/number_text.hpp>
 #include <trackflow/kalman.hpp>
 #include <trackflow/plugin.hpp>
 #include <trackflow/spherical_measurement.hpp>
@@ -53,8 +54,7 @@ class UnscentedKalmanFilter final
   void on_end_run_report() {
     // Numerical repairs are counted rather than reported at every step.
     if (jitter_count_ > 0) {
-      char buf[48];
-      std::snprintf(buf, sizeof buf, "%.3g", max_jitter_);
+      const std::string buf = number_text::general(max_jitter_, 3);
       this->warn("state covariance not numerically positive definite at " + std::to_string(jitter_count_) + " of " +
                  std::to_string(updates_) + " updates: symmetrised, up to " + buf +
                  " added to its diagonal before drawing sigma points");

@@ -1,6 +1,8 @@
 // Purpose: reading, checking and looking up the radar's schedule windows.
 #include "time_windows.hpp"
 
+#include <trackflow/number_text.hpp>
+
 #include <algorithm>
 #include <cstdio>
 #include <numeric>
@@ -13,9 +15,7 @@ std::optional<double> optional_real(const Params& rec, const char* name) {
 }
 
 std::string seconds(double t) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.10g s", t);
-  return buf;
+  return number_text::general(t, 10) + " s";
 }
 
 }  // namespace

@@ -2,6 +2,7 @@
 #include "interval_sums.hpp"
 #include "scoring/truth_match.hpp"
 
+#include <trackflow/number_text.hpp>
 #include <trackflow/common_params.hpp>
 #include <trackflow/error.hpp>
 #include <trackflow/geometry.hpp>
@@ -218,9 +219,7 @@ class AngleErrorSink final : public Component, public FieldListCodec<AngleRunRes
   };
 
   static std::string number(double t) {
-    char buf[32];
-    std::snprintf(buf, sizeof buf, "%g", t);
-    std::string s(buf);
+    std::string s = number_text::general(t, 6);  // printf's "%g"
     std::replace(s.begin(), s.end(), '.', 'p');
     std::replace(s.begin(), s.end(), '-', 'm');
     s.erase(std::remove(s.begin(), s.end(), '+'), s.end());

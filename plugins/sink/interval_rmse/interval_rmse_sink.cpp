@@ -1,6 +1,7 @@
 // Purpose: sink.interval_rmse — a filter's position RMSE next to the measurements' own, interval by interval (e.g. every 60 s of a launch).
 #include "scoring/truth_match.hpp"
 
+#include <trackflow/number_text.hpp>
 #include <trackflow/geometry.hpp>
 #include <trackflow/plugin.hpp>
 #include <trackflow/run_result_codec.hpp>
@@ -185,9 +186,7 @@ class IntervalRmseSink final : public Component, public FieldListCodec<IntervalR
   }
 
   std::string label(size_t i) const {
-    char buf[40];
-    std::snprintf(buf, sizeof buf, "%gs", start_ + static_cast<double>(i) * interval_);
-    std::string s(buf);
+    std::string s = number_text::general(start_ + static_cast<double>(i) * interval_, 6) + "s";  // printf's "%gs"
     std::replace(s.begin(), s.end(), '.', 'p');
     std::replace(s.begin(), s.end(), '-', 'm');
     s.erase(std::remove(s.begin(), s.end(), '+'), s.end());

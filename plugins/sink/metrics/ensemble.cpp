@@ -3,6 +3,8 @@
 
 #include "scoring/chi_square_band.hpp"
 
+#include <trackflow/number_text.hpp>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -139,9 +141,7 @@ std::string count_text(std::uint64_t n, const char* what) {
 }
 
 std::string seconds_text(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%g s", v);
-  return buf;
+  return number_text::general(v, 6) + " s";  // printf's "%g s"
 }
 
 // Never lets a NaN or infinity reach the summary: it becomes a note instead.

@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <trackflow/number_text.hpp>
 #include <trackflow/geometry.hpp>
 #include <trackflow/common_params.hpp>
 #include <trackflow/plugin.hpp>
@@ -36,9 +37,7 @@ struct Column {
 };
 
 std::string format_number(double v) {
-  char buf[32];
-  std::snprintf(buf, sizeof buf, "%.10g", v);
-  return buf;
+  return number_text::general(v, 10);
 }
 
 enum class LogFrame { Spherical, Cartesian };
