@@ -1,4 +1,4 @@
-// Purpose: tests of filter.track_fusion as a node: information fusion of two local tracks equals the hand-computed sum of their information, CI publishes a fused estimate, a mismatched state size is refused.
+// Purpose: tests of filter.track_fusion as a node: information fusion of two local tracks equals the hand-computed sum of their information, CI publishes a fused estimate, a mismatched state size is refused, the shared motion block's checks.
 #include <catch2/catch.hpp>
 
 #include "plugin_fixture.hpp"
@@ -77,4 +77,22 @@ TEST_CASE("track_fusion: node refuses another state size") {
   test::Collector out;
   auto n = node("{motion: constant_acceleration}", out);
   CHECK_THROWS_AS(n->on_estimate(cv_estimate(0.0, 0.0, 1.0), 0), DataError);
+}
+
+// The motion block is the Cartesian filters' own (lib/estimation): the same checks of its
+// combination, each naming its parameter.
+TEST_CASE("track_fusion: shared motion block checks") {
+  const auto refused = [](const std::string& yaml, const std::string& param) {
+    try {
+      test::make("filter.track_fusion", yaml);
+    } catch (const ConfigError& e) {
+      const std::string what = e.what();
+      return what.find(param) != std::string::npos;
+    }
+    return false;
+  };
+  CHECK(refused("{motion: constant_velocity, q_jerk: 1 m2/s5}", "q_jerk"));
+  CHECK(refused("{motion: singer, singer_alpha: 1 1/s}", "singer_sigma"));
+  CHECK(refused("{q: 1 m2/s3, sigma_accel: 1 m/s2}", "sigma_accel"));
+  CHECK_NOTHROW(test::make("filter.track_fusion", "{motion: singer, singer_alpha: 1 1/s, singer_sigma: 5 m/s2}"));
 }

@@ -1,6 +1,8 @@
 // Purpose: filter.track_fusion — track-to-track fusion of two or more filters' estimates (covariance intersection, or information matrix fusion that counts the common process noise once).
 #include "fusion_math.hpp"
 
+#include "estimation/cartesian_filter_settings.hpp"
+
 #include <trackflow/error.hpp>
 #include <trackflow/estimate_state.hpp>
 #include <trackflow/motion.hpp>
@@ -16,17 +18,14 @@ namespace trackflow {
 namespace {
 
 enum class Method { CovarianceIntersection, Information, Independent };
-enum class Motion { ConstantVelocity, ConstantAcceleration, Singer };
-enum class Noise { Continuous, Discrete, Singer };
+using Motion = cartesian_filter::MotionModel::Motion;
+using Noise = cartesian_filter::MotionModel::Noise;
 
-struct Settings {
+// The inputs' motion model (the Cartesian filters' parameter block), the fusion method.
+struct Settings : cartesian_filter::MotionModel {
   Method method = Method::CovarianceIntersection;
   fusion::CiCriterion criterion = fusion::CiCriterion::Trace;
-  Motion motion = Motion::ConstantVelocity;
-  Noise noise = Noise::Continuous;
-  double intensity = 1.0, singer_alpha = 1.0;
   std::string node;
-  int order() const { return motion == Motion::ConstantVelocity ? 2 : 3; }
 };
 
 constexpr int kMaxInputs = 8;
@@ -258,27 +257,7 @@ Settings parse(const Params& p) {
   s.criterion = p.choice<fusion::CiCriterion>("ci_criterion");
   if (s.method != Method::CovarianceIntersection && p.given("ci_criterion"))
     throw p.error("ci_criterion", "is for method: covariance_intersection");
-  s.motion = p.choice<Motion>("motion");
-  const bool cv = s.motion == Motion::ConstantVelocity, ca = s.motion == Motion::ConstantAcceleration,
-             singer = s.motion == Motion::Singer;
-  if (!cv && p.given("q")) throw p.error("q", "q (m2/s3) is the constant_velocity intensity");
-  if (!ca && p.given("q_jerk")) throw p.error("q_jerk", "q_jerk is for motion: constant_acceleration");
-  for (const char* name : {"singer_alpha", "singer_sigma"}) {
-    if (!singer && p.given(name)) throw p.error(name, std::string(name) + " is for motion: singer");
-    if (singer && !p.has(name)) throw p.error(name, "required with motion: singer");
-  }
-  if (p.given("sigma_accel") && (singer || p.given("q") || p.given("q_jerk")))
-    throw p.error("sigma_accel", "give one noise: q / q_jerk (continuous), sigma_accel (discrete) or singer_sigma");
-  if (singer) {
-    s.noise = Noise::Singer;
-    s.intensity = p.real("singer_sigma");
-    s.singer_alpha = p.real("singer_alpha");
-  } else if (p.given("sigma_accel")) {
-    s.noise = Noise::Discrete;
-    s.intensity = p.real("sigma_accel");
-  } else {
-    s.intensity = ca ? p.real("q_jerk") : p.real("q");
-  }
+  cartesian_filter::parse_motion(p, s);
   return s;
 }
 
@@ -329,23 +308,9 @@ void register_components(Registrar& r) {
                                              "covariance intersection: the weight minimises the fused covariance's "
                                              "trace or its determinant")
           .def("trace"),
-      ParamSpec::choice<Motion>("motion",
-                                {{Motion::ConstantVelocity, "constant_velocity"},
-                                 {Motion::ConstantAcceleration, "constant_acceleration"},
-                                 {Motion::Singer, "singer"}},
-                                "the local filters' motion model")
-          .def("constant_velocity"),
-      ParamSpec::real("q", dim::accel_psd, "constant_velocity: the local filters' white-acceleration spectral density")
-          .def("1 m2/s3")
-          .at_least(0),
-      ParamSpec::real("q_jerk", dim::jerk_psd, "constant_acceleration: the local filters' white-jerk spectral density")
-          .def("1 m2/s5")
-          .at_least(0),
-      ParamSpec::real("sigma_accel", dim::acceleration, "the local filters' discrete white-noise std instead")
-          .at_least(0),
-      ParamSpec::real("singer_alpha", dim::frequency, "singer: the local filters' inverse correlation time").positive(),
-      ParamSpec::real("singer_sigma", dim::acceleration, "singer: the local filters' acceleration std").positive(),
   };
+  // The local filters' motion and noise, declared as theirs (the same words in the same units).
+  for (ParamSpec& spec : cartesian_filter::motion_param_specs()) d.params.push_back(std::move(spec));
   d.create = create;
   r.add(std::move(d));
 }

@@ -1,4 +1,4 @@
-// Purpose: settings of the Cartesian-state radar filters (filter.ekf, filter.ukf) — motion and noise model, range-rate use, initialisation — with their parameter declarations and parsing.
+// Purpose: settings of the Cartesian-state radar filters (filter.ekf, filter.ukf; the motion block also filter.imm's modes and filter.track_fusion) — motion and noise model, range-rate use, initialisation — with their parameter declarations and parsing.
 #pragma once
 
 #include <trackflow/filter_front_end.hpp>
@@ -11,12 +11,20 @@
 
 namespace trackflow::cartesian_filter {
 
-struct Settings {
+// The motion and noise model the motion parameters give (motion_param_specs, parse_motion): every
+// Cartesian radar filter's, each mode of filter.imm's, and filter.track_fusion's model of its inputs.
+struct MotionModel {
   enum class Motion { ConstantVelocity, ConstantAcceleration, Singer } motion = Motion::ConstantVelocity;
   // Continuous: q (CV, m2/s3) or q_jerk (CA, m2/s5); Discrete: sigma_accel; Singer: singer_sigma.
   enum class Noise { Continuous, Discrete, Singer } noise = Noise::Continuous;
   double intensity = 1.0;
   double singer_alpha = 1.0;
+
+  int order() const { return motion == Motion::ConstantVelocity ? 2 : 3; }  // states per axis
+  int state_dim() const { return 3 * order(); }
+};
+
+struct Settings : MotionModel {
   RangeRateUse range_rate = RangeRateUse::Auto;
   enum class Init { TwoPoint, Explicit, Paper000 } init = Init::TwoPoint;
   // Near the zenith: add the angles' curvature variance to R and drop the azimuth while the
@@ -26,12 +34,10 @@ struct Settings {
   double sp0 = 0, sv0 = 0, sa0 = 0;  // initial standard deviations
   std::string type;                  // component type, for messages ("filter.ekf")
   std::string node;
-
-  int order() const { return motion == Motion::ConstantVelocity ? 2 : 3; }  // states per axis
-  int state_dim() const { return 3 * order(); }
 };
 
-// Motion and noise parameters: every Cartesian radar filter's, and each mode of filter.imm.
+// Motion and noise parameters, declared once: every Cartesian radar filter's, each mode of
+// filter.imm's and filter.track_fusion's (the model of its inputs).
 inline std::vector<ParamSpec> motion_param_specs() {
   return {
       ParamSpec::choice<Settings::Motion>("motion",
@@ -96,8 +102,8 @@ inline std::vector<ParamSpec> param_specs() {
 
 // Validates the combination of motion_param_specs() (each one alone was checked by its ParamSpec)
 // and sets the motion and noise of `s`.
-inline void parse_motion(const Params& p, Settings& s) {
-  using S = Settings;
+inline void parse_motion(const Params& p, MotionModel& s) {
+  using S = MotionModel;
   s.motion = p.choice<S::Motion>("motion");
   const bool cv = s.motion == S::Motion::ConstantVelocity, ca = s.motion == S::Motion::ConstantAcceleration,
              singer = s.motion == S::Motion::Singer;
