@@ -10,6 +10,7 @@
 #include <cmath>
 #include <numbers>
 
+#include "estimation/radar_filter_test_support.hpp"
 #include "plugin_fixture.hpp"
 
 using namespace trackflow;
@@ -23,31 +24,11 @@ struct Noise {
   double r = 10.0, az = 1e-3, el = 1e-3, rdot = 0.5;
 };
 
-// A radar at `sensor` measuring the target at absolute position p with velocity v.
+// A radar at `sensor` measuring the target at absolute position p with velocity v (the Cartesian
+// filters' shared test helper: the same draws in the same order).
 Measurement radar(double t, const Vec3& sensor, const Vec3& p, const Vec3& v, const Noise& s, bool with_rate,
                   AzimuthConvention c, Rng& rng) {
-  Measurement m;
-  m.time = t;
-  m.frame = Frame::Spherical;
-  m.azimuth = c;
-  m.sensor_position = sensor;
-  m.has_range_rate = with_rate;
-  const Vec3 d = p - sensor;
-  const Vec3 z = enu_to_spherical(d, c);
-  const int n = with_rate ? 4 : 3;
-  m.value.resize(n);
-  m.covariance = MeasCov::Zero(n, n);
-  m.value(0) = z(0) + s.r * rng.normal();
-  m.value(1) = wrap_angle(z(1) + s.az * rng.normal());
-  m.value(2) = z(2) + s.el * rng.normal();
-  m.covariance(0, 0) = s.r * s.r;
-  m.covariance(1, 1) = s.az * s.az;
-  m.covariance(2, 2) = s.el * s.el;
-  if (with_rate) {
-    m.value(3) = range_rate(d, v) + s.rdot * rng.normal();
-    m.covariance(3, 3) = s.rdot * s.rdot;
-  }
-  return m;
+  return filter_test::radar(t, p, v, sensor, {s.r, s.az, s.el, s.rdot}, &rng, with_rate, c);
 }
 
 struct Track {
