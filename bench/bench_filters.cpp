@@ -11,6 +11,7 @@
 #include "bench_common.hpp"
 
 #include <trackflow/host/config.hpp>
+#include <trackflow/host/filter_control.hpp>
 #include <trackflow/host/plugins.hpp>
 #include <trackflow/host/validate.hpp>
 
@@ -93,7 +94,7 @@ Row prepare(const host::PluginRegistry& reg, const std::string& type, const std:
   Row row{type, make(reg, type, params)};
   if (!row.filter) return row;
   // A filter's own annotations (filter.imm's mode probabilities) get their slots as in the engine.
-  if (auto* f = dynamic_cast<Filter*>(row.filter.get())) f->reserve_own_annotations(static_cast<int>(f->annotation_names().size()));
+  if (auto* f = dynamic_cast<Filter*>(row.filter.get())) host::FilterControl::reserve_own_annotations(*f, static_cast<int>(f->annotation_names().size()));
   // Accuracy pass with the outputs recorded; the timed passes have no consumer.
   Recorder rec;
   const Link link{&rec, 0, mask(ItemKind::Estimate)};

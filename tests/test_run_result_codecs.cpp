@@ -1,5 +1,6 @@
 // Purpose: every per-run result of every pipeline in pipelines/ crosses the RunResultCodec round trip exactly (what mpirun relies on), without MPI: a node that returns a result without the codec fails, and merging the decoded results gives the same summary and files as merging the originals.
 #include <trackflow/host/config.hpp>
+#include <trackflow/host/filter_control.hpp>
 #include <trackflow/host/graph.hpp>
 #include <trackflow/host/guard.hpp>
 #include <trackflow/rng.hpp>
@@ -145,7 +146,7 @@ void check_pipeline(const fs::path& file, std::uint64_t runs) {
     std::vector<std::unique_ptr<RunResult>> results(N);
     {
       OutputDirectoryScope scope(work);  // where sink.csv spills a large run
-      for (Filter* f : filters) f->reset_adapted_state();
+      for (Filter* f : filters) host::FilterControl::reset_adapted_state(*f);
       for (size_t i = 0; i < N; ++i)
         inst.components[i]->start_run({run, derive_seed(cfg.seed, run, g.nodes[i].config.id), &diag});
       drive(inst);

@@ -257,7 +257,7 @@ int cmd_plugins(int argc, char** argv) {
 
 std::string kinds_text(ItemMask m) {
   std::vector<std::string> k;
-  for (ItemKind i : {ItemKind::Truth, ItemKind::Measurement, ItemKind::Estimate})
+  for (ItemKind i : kItemKinds)
     if (m & mask(i)) k.push_back(to_string(i));
   return k.empty() ? "-" : join(k, ", ");
 }

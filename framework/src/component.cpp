@@ -21,6 +21,8 @@ const char* to_string(ItemKind k) {
     case ItemKind::Truth: return "truth";
     case ItemKind::Measurement: return "measurement";
     case ItemKind::Estimate: return "estimate";
+    case ItemKind::Scan: return "scan";
+    case ItemKind::Tracks: return "tracks";
   }
   return "?";
 }
@@ -45,6 +47,18 @@ void Component::on_measurement(const Measurement&, int) {
   throw std::logic_error("component received a measurement it does not handle");
 }
 void Component::on_estimate(const Estimate&, int) { throw std::logic_error("component received an estimate it does not handle"); }
+void Component::on_scan(const Scan&, int) { throw std::logic_error("component received a scan it does not handle"); }
+void Component::on_tracks(const TrackSet&, int) { throw std::logic_error("component received a track set it does not handle"); }
+
+const char* to_string(TrackStatus s) {
+  switch (s) {
+    case TrackStatus::Tentative: return "tentative";
+    case TrackStatus::Confirmed: return "confirmed";
+    case TrackStatus::Coasting: return "coasting";
+    case TrackStatus::Deleted: return "deleted";
+  }
+  return "?";
+}
 
 void Adapter::before_update(const Measurement&, Filter&) {}
 void Adapter::after_update(const Measurement&, const Estimate&, Filter&) {}

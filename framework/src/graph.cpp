@@ -1,5 +1,6 @@
 // Purpose: graph construction and checks (types, parameters, wiring, cycles) and per-thread instantiation.
 #include <trackflow/host/graph.hpp>
+#include <trackflow/host/filter_control.hpp>
 #include <trackflow/host/guard.hpp>
 #include <trackflow/host/suggest.hpp>
 #include <trackflow/host/validate.hpp>
@@ -15,7 +16,7 @@ namespace {
 
 std::string kinds(ItemMask m) {
   std::vector<std::string> k;
-  for (ItemKind i : {ItemKind::Truth, ItemKind::Measurement, ItemKind::Estimate})
+  for (ItemKind i : kItemKinds)
     if (m & mask(i)) k.push_back(to_string(i));
   return k.empty() ? "nothing" : join(k, "/");
 }
@@ -314,7 +315,7 @@ GraphInstance instantiate_checked(const Graph& g, const PluginRegistry& registry
     if (!filter) continue;
     const std::vector<std::string> names = filter->annotation_names();
     if (names.empty()) continue;
-    if (!filter->reserve_own_annotations(static_cast<int>(names.size())))
+    if (!FilterControl::reserve_own_annotations(*filter, static_cast<int>(names.size())))
       throw ConfigError("filter '" + g.nodes[i].config.id + "' publishes " + std::to_string(names.size()) +
                             " annotations; at most " + std::to_string(kMaxAnnotations) + " fit on an estimate",
                         g.nodes[i].config.loc, g.nodes[i].config.id);
@@ -335,7 +336,7 @@ GraphInstance instantiate_checked(const Graph& g, const PluginRegistry& registry
                             "' (" + g.nodes[n.attach_to].config.type + "): " + why,
                         n.config.attach_loc, n.config.id);
     const std::vector<std::string> names = adapter->annotation_names();
-    if (!filter->attach(adapter, static_cast<int>(names.size())))
+    if (!FilterControl::attach(*filter, *adapter, static_cast<int>(names.size())))
       throw ConfigError("too many adapters or annotations on '" + fid + "' (at most " +
                             std::to_string(Filter::kMaxAdapters) + " adapters and " + std::to_string(kMaxAnnotations) +
                             " annotations per filter)",
@@ -343,12 +344,25 @@ GraphInstance instantiate_checked(const Graph& g, const PluginRegistry& registry
     for (size_t k = 0; k < names.size(); ++k) annotations[n.attach_to].push_back(qualified(n.config.id, names, k));
   }
 
+  // A node's items are in time order when every source upstream declares so: the engine merges
+  // the sources by time and every other node emits as it receives (g.order: inputs first).
+  std::vector<char> time_ordered(N, 0);
+  for (int i : g.order) {
+    const GraphNode& n = g.nodes[i];
+    bool ordered = n.inputs.empty() ? n.type->decl.time_ordered : true;
+    for (int up : n.inputs) ordered = ordered && time_ordered[up];
+    time_ordered[i] = ordered;
+  }
   for (size_t i = 0; i < N; ++i) {
     const GraphNode& n = g.nodes[i];
     std::vector<InputInfo> infos;
-    for (size_t k = 0; k < n.inputs.size(); ++k)
-      infos.push_back({g.nodes[n.inputs[k]].config.id, g.nodes[n.inputs[k]].config.type, n.input_kinds[k],
-                       annotations[n.inputs[k]]});
+    for (size_t k = 0; k < n.inputs.size(); ++k) {
+      const int up = n.inputs[k];
+      InputInfo info{g.nodes[up].config.id, g.nodes[up].config.type, n.input_kinds[k], annotations[up]};
+      if (const auto* f = dynamic_cast<const Filter*>(inst.components[up].get())) info.state = f->state_layout();
+      info.time_ordered = time_ordered[up];
+      infos.push_back(std::move(info));
+    }
     try {
       inst.components[i]->set_inputs(infos);
     } catch (const ConfigError& e) {
@@ -373,7 +387,7 @@ GraphInstance instantiate_checked(const Graph& g, const PluginRegistry& registry
     inst.components[i]->out.connect(inst.links[i].data(), static_cast<int>(inst.links[i].size()));
   // What adapters tune is put back to this at the start of every run (engine).
   for (auto& c : inst.components)
-    if (auto* f = dynamic_cast<Filter*>(c.get())) f->save_configured_noise();
+    if (auto* f = dynamic_cast<Filter*>(c.get())) FilterControl::save_configured_noise(*f);
   return inst;
 }
 

@@ -1,5 +1,6 @@
 // Purpose: the SDK test fixture's implementation in the host: plugins loaded by the real loader, parameters validated as in a pipeline.
 #include <trackflow/host/config.hpp>
+#include <trackflow/host/filter_control.hpp>
 #include <trackflow/host/plugin_fixture_state.hpp>
 #include <trackflow/host/validate.hpp>
 
@@ -36,9 +37,24 @@ std::shared_ptr<Component> PluginFixture::make(const std::string& type, const st
   std::shared_ptr<Component> c = registry.create(*registry.find(type), params_for(type, yaml_params, node_id));
   // A filter's own annotations get their slots as in the engine (graph.cpp).
   if (auto* f = dynamic_cast<Filter*>(c.get()))
-    if (!f->reserve_own_annotations(static_cast<int>(f->annotation_names().size())))
+    if (!host::FilterControl::reserve_own_annotations(*f, static_cast<int>(f->annotation_names().size())))
       throw std::runtime_error("too many annotations on a " + type);
   return c;
+}
+
+void attach(Adapter& adapter, Filter& filter) {
+  const std::string why = noise_mismatch(adapter.needs(), filter.noise(), filter.has_covariance_access());
+  if (!why.empty()) throw std::runtime_error("cannot attach: " + why);
+  if (!host::FilterControl::attach(filter, adapter, static_cast<int>(adapter.annotation_names().size())))
+    throw std::runtime_error("cannot attach: too many adapters or annotations");
+  host::FilterControl::save_configured_noise(filter);
+}
+
+void save_configured_noise(Filter& filter) { host::FilterControl::save_configured_noise(filter); }
+
+void start_run(Component& c, std::uint64_t run, std::uint64_t seed, Diagnostics* diag) {
+  if (auto* f = dynamic_cast<Filter*>(&c)) host::FilterControl::reset_adapted_state(*f);
+  c.start_run({run, seed, diag});
 }
 
 }  // namespace trackflow::testing

@@ -33,6 +33,9 @@ std::string size_mismatch(const PluginInfo& info) {
   check("Truth", info.sizeof_truth, mine.sizeof_truth);
   check("Measurement", info.sizeof_measurement, mine.sizeof_measurement);
   check("Estimate", info.sizeof_estimate, mine.sizeof_estimate);
+  check("Scan", info.sizeof_scan, mine.sizeof_scan);
+  check("TrackSet", info.sizeof_track_set, mine.sizeof_track_set);
+  check("InputInfo", info.sizeof_input_info, mine.sizeof_input_info);
   check("Params", info.sizeof_params, mine.sizeof_params);
   check("Component", info.sizeof_component, mine.sizeof_component);
   return m;

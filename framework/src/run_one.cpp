@@ -1,6 +1,7 @@
 // Purpose: one Monte Carlo run on one graph instance, shared by the engine and the MPI engine.
 #include "run_one.hpp"
 
+#include <trackflow/host/filter_control.hpp>
 #include <trackflow/rng.hpp>
 
 #include <cmath>
@@ -108,15 +109,15 @@ RunRecord run_one(const Graph& g, GraphInstance& inst, const std::vector<Filter*
   // run on this instance: otherwise results would depend on which thread ran which run.
   for (Filter* f : filters) {
     detail::executing = f;
-    f->reset_adapted_state();
+    FilterControl::reset_adapted_state(*f);
   }
   for (std::size_t i = 0; i < N; ++i) {
     detail::executing = inst.components[i].get();
     inst.components[i]->start_run({run, derive_seed(seed, run, g.nodes[i].config.id), &rec.diagnostics});
   }
-  for (Filter* f : filters) f->take_processed();  // a failed earlier run may have left counts
+  for (Filter* f : filters) FilterControl::take_processed(*f);  // a failed earlier run may have left counts
   rec.source_items = drive(inst);
-  for (Filter* f : filters) rec.measurements_processed += f->take_processed();
+  for (Filter* f : filters) rec.measurements_processed += FilterControl::take_processed(*f);
   rec.results.resize(N);
   for (std::size_t i = 0; i < N; ++i) {
     detail::executing = inst.components[i].get();

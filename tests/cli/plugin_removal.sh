@@ -47,6 +47,16 @@ cp "$(ldconfig -p | grep -m1 -o '/[^ ]*libm\.so\.6')" "$TMP/plugins/tfplugin_not
 expect_run "a library without the entry point is 'not a trackflow plugin'" 2 "tfplugin_notours.so: entry: not a trackflow plugin" -- \
   "$TF" plugins --no-default-plugins --plugin-path "$TMP/plugins"
 rm "$TMP/plugins/tfplugin_notours.so"
+# Plugins built against an older SDK are refused at the "abi" stage, naming both versions, and
+# their registration is never run (it traps); the other plugins still load.
+for abi in 3 4; do
+  cp "$PLUGINS/../old-abi-plugins/tfplugin_test_abi$abi.so" "$TMP/plugins/"
+  expect_run "an ABI-$abi plugin is refused with a clear message" 2 \
+    "tfplugin_test_abi$abi.so: abi: built against plugin ABI $abi \\(SDK 0\\.$abi\\.[01]\\); this trackflow needs ABI 5 \\(SDK 0\\.5\\.[0-9]\\): rebuild the plugin" -- \
+    "$TF" plugins --no-default-plugins --plugin-path "$TMP/plugins"
+  list | grep -q '"sink.metrics"' || fail "an ABI-$abi plugin in the folder stopped the other plugins from loading"
+  rm "$TMP/plugins/tfplugin_test_abi$abi.so"
+done
 expect_run "an unknown type lists what exists and where it looked" 2 "unknown type 'sink.csv'.*Available: .*sink.metrics.*Searched: $TMP/plugins" -- \
   "$TF" describe sink.csv --no-default-plugins --plugin-path "$TMP/plugins"
 finish

@@ -125,4 +125,19 @@ runs=$(awk -F, 'NR > 1 { print $1 }' "$TMP/t1/rows.csv" | sort -u | wc -l)
 [ "$runs" -eq 4 ] || fail "expected 4 runs in rows.csv, found $runs"
 checks=$((checks + 1)); echo "ok: every run starts from the configured q, identical for 1 and 2 threads"
 
+
+# 5. What set_inputs learns (InputInfo, SDK 0.5): an upstream filter's state layout by name and
+# unit, and whether the input is time-ordered (every source upstream declares it).
+{ radar_nodes; classical_kalman; cat <<'YAML'
+  - id: probe
+    type: test.input_probe
+    inputs: [kf, radar, truth]
+YAML
+} > "$TMP/probe.yaml"
+expect_run "a filter input carries the filter's state layout and its time order" 0 \
+  "input kf: time_ordered=yes, state=\\[x\\(m\\) vx\\(m/s\\) y\\(m\\) vy\\(m/s\\) z\\(m\\) vz\\(m/s\\)\\]" -- \
+  "$TF" run "$TMP/probe.yaml" --plugin-path "$TEST_PLUGINS" --threads 1 --no-progress --out "$TMP/probe"
+expect_run "a measurement input carries no state layout" 0 "input radar: time_ordered=yes, state=\\[\\]" -- \
+  "$TF" run "$TMP/probe.yaml" --plugin-path "$TEST_PLUGINS" --threads 1 --no-progress --out "$TMP/probe"
+
 finish

@@ -11,6 +11,9 @@ namespace trackflow::test {
 
 using testing::Collector;
 using testing::drain;
+using testing::attach;
+using testing::save_configured_noise;
+using testing::start_run;
 
 // The fixture of every plugin built in this tree (loaded once per test process).
 const testing::PluginFixture& fixture();

@@ -1,7 +1,9 @@
-// Purpose: the interfaces a plugin implements: Component, Generator (root source), Filter, Adapter, and the filter–adapter contract.
+// Purpose: the interfaces a plugin implements: Component (truth, measurement, estimate, scan and track-set inputs), Generator (root source), Filter, Adapter, and the filter–adapter contract.
 #pragma once
 
 #include <trackflow/items.hpp>
+#include <trackflow/scan.hpp>
+#include <trackflow/tracks.hpp>
 #include <trackflow/noise.hpp>
 #include <trackflow/series.hpp>
 
@@ -16,6 +18,9 @@
 namespace trackflow {
 
 class Component;
+namespace host {
+class FilterControl;  // the engine's side of Filter and Adapter (host/filter_control.hpp, not in the SDK)
+}
 
 namespace detail {
 // The component this thread is executing: set around every delivery (Outputs::emit, adapter
@@ -98,6 +103,13 @@ struct InputInfo {
   ItemMask kinds = 0; // item kinds this input delivers
   // A filter's input: the names of Estimate::annotations, "<adapter id>.<name>", in order.
   std::vector<std::string> annotations;
+  // A filter's input: the names and units of Estimate::state (look components up with
+  // state.index_of("b")); empty for other inputs. Points into the upstream plugin, which stays
+  // loaded while this node exists.
+  StateLayout state;
+  // Whether this input's items arrive in non-decreasing time within a run (every source upstream
+  // declares ComponentDecl::time_ordered), so a sink may score an item as soon as its truth is known.
+  bool time_ordered = false;
 };
 
 struct FinishContext {
@@ -116,9 +128,13 @@ class Outputs {
   inline void emit(const Truth& t) const;
   inline void emit(const Measurement& m) const;
   inline void emit(const Estimate& e) const;
+  inline void emit(const Scan& s) const;
+  inline void emit(const TrackSet& t) const;
   int count() const { return count_; }
 
  private:
+  template <ItemKind K, class Item, class Handler>
+  void deliver(const Item& item, Handler handler) const;
   const Link* links_ = nullptr;
   int count_ = 0;
 };
@@ -139,6 +155,8 @@ class BOOST_SYMBOL_VISIBLE Component {
   virtual void on_truth(const Truth&, int port);
   virtual void on_measurement(const Measurement&, int port);
   virtual void on_estimate(const Estimate&, int port);
+  virtual void on_scan(const Scan&, int port);
+  virtual void on_tracks(const TrackSet&, int port);
   // Called after the last item of a run; the result (may be null) goes to merge() of the
   // aggregating instance, in run order, so reductions are identical whatever the thread count.
   virtual std::unique_ptr<RunResult> end_run() { return nullptr; }
@@ -175,16 +193,14 @@ class BOOST_SYMBOL_VISIBLE Adapter : public Component {
   virtual void before_update(const Measurement& m, Filter& f);
   virtual void after_update(const Measurement& m, const Estimate& e, Filter& f);
 
-  // Engine side: where this adapter's annotations start in the filter's list.
-  void set_first_annotation(int slot) { first_annotation_ = slot; }
-
  protected:
   // Sets annotation `i` (index into annotation_names()) on the filter's next estimates; it
   // stays until changed. NaN: no value.
   inline void annotate(Filter& f, int i, double value) const;
 
  private:
-  int first_annotation_ = 0;
+  friend class host::FilterControl;
+  int first_annotation_ = 0;  // where this adapter's annotations start in its filter's list
 };
 
 class BOOST_SYMBOL_VISIBLE Filter : public Component {
@@ -207,45 +223,6 @@ class BOOST_SYMBOL_VISIBLE Filter : public Component {
   virtual void scale_covariance(double /*factor*/) {}
   // Forgets the track: the next measurements initialise it again.
   virtual void restart_track() {}
-
-  // Engine side: measurements this filter has published an estimate for since the last call.
-  std::uint64_t take_processed() {
-    const std::uint64_t n = processed_;
-    processed_ = 0;
-    return n;
-  }
-  // Engine side: reserves the filter's own annotation slots (call before any attach); false when
-  // there is no room.
-  bool reserve_own_annotations(int count) {
-    if (adapter_count_ > 0 || count < 0 || annotation_count_ + count > kMaxAnnotations) return false;
-    annotation_count_ += count;
-    own_annotation_count_ += count;
-    return true;
-  }
-  // Engine side: attaches `a` with `annotations` values; false when there is no room.
-  bool attach(Adapter* a, int annotations) {
-    if (adapter_count_ >= kMaxAdapters || annotation_count_ + annotations > kMaxAnnotations) return false;
-    a->set_first_annotation(annotation_count_);
-    annotation_count_ += annotations;
-    adapters_[adapter_count_++] = a;
-    return true;
-  }
-  // Engine side: remembers the process noise as configured (call once, before any run) ...
-  void save_configured_noise() {
-    const ProcessNoiseHandle q = noise().process;
-    configured_count_ = q ? (q.count < kMaxNoiseValues ? q.count : kMaxNoiseValues) : 0;
-    for (int i = 0; i < configured_count_; ++i) configured_[i] = q.values[i];
-  }
-  // ... and puts it back, with no annotation values, at the start of every run, so what an
-  // adapter tuned in one run never leaks into the next (whichever thread runs it).
-  void reset_adapted_state() {
-    const ProcessNoiseHandle q = noise().process;
-    for (int i = 0; i < configured_count_ && q && i < q.count; ++i) q.values[i] = configured_[i];
-    for (double& a : annotation_values_) a = kNoAnnotation;
-  }
-  void set_annotation(int slot, double value) {
-    if (slot >= 0 && slot < annotation_count_) annotation_values_[slot] = value;
-  }
 
  protected:
   static constexpr double kNoAnnotation = std::numeric_limits<double>::quiet_NaN();
@@ -276,6 +253,15 @@ class BOOST_SYMBOL_VISIBLE Filter : public Component {
   }
 
  private:
+  // The engine's side of a filter (attaching adapters, their annotation slots, the configured
+  // noise put back at every run, the count of published estimates) is host::FilterControl's,
+  // not part of what a plugin calls.
+  friend class host::FilterControl;
+  friend class Adapter;
+  void set_annotation(int slot, double value) {
+    if (slot >= 0 && slot < annotation_count_) annotation_values_[slot] = value;
+  }
+
   static constexpr int kMaxNoiseValues = 8;
   Adapter* adapters_[kMaxAdapters] = {};
   int adapter_count_ = 0;
@@ -292,32 +278,20 @@ inline void Adapter::annotate(Filter& f, int i, double value) const { f.set_anno
 
 // Each delivery marks its target as executing; if the target throws, the mark stays on the
 // innermost node, which is the one the host names.
-inline void Outputs::emit(const Truth& t) const {
+template <ItemKind K, class Item, class Handler>
+inline void Outputs::deliver(const Item& item, Handler handler) const {
   Component* const self = detail::executing;
   for (int i = 0; i < count_; ++i)
-    if (links_[i].accepts & mask(ItemKind::Truth)) {
+    if (links_[i].accepts & mask(K)) {
       detail::executing = links_[i].target;
-      links_[i].target->on_truth(t, links_[i].port);
+      (links_[i].target->*handler)(item, links_[i].port);
     }
   detail::executing = self;
 }
-inline void Outputs::emit(const Measurement& m) const {
-  Component* const self = detail::executing;
-  for (int i = 0; i < count_; ++i)
-    if (links_[i].accepts & mask(ItemKind::Measurement)) {
-      detail::executing = links_[i].target;
-      links_[i].target->on_measurement(m, links_[i].port);
-    }
-  detail::executing = self;
-}
-inline void Outputs::emit(const Estimate& e) const {
-  Component* const self = detail::executing;
-  for (int i = 0; i < count_; ++i)
-    if (links_[i].accepts & mask(ItemKind::Estimate)) {
-      detail::executing = links_[i].target;
-      links_[i].target->on_estimate(e, links_[i].port);
-    }
-  detail::executing = self;
-}
+inline void Outputs::emit(const Truth& t) const { deliver<ItemKind::Truth>(t, &Component::on_truth); }
+inline void Outputs::emit(const Measurement& m) const { deliver<ItemKind::Measurement>(m, &Component::on_measurement); }
+inline void Outputs::emit(const Estimate& e) const { deliver<ItemKind::Estimate>(e, &Component::on_estimate); }
+inline void Outputs::emit(const Scan& s) const { deliver<ItemKind::Scan>(s, &Component::on_scan); }
+inline void Outputs::emit(const TrackSet& t) const { deliver<ItemKind::Tracks>(t, &Component::on_tracks); }
 
 }  // namespace trackflow

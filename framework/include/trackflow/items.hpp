@@ -1,8 +1,9 @@
-// Purpose: the data items that flow through a pipeline: Truth, Measurement, Estimate.
+// Purpose: the data items that flow through a pipeline: Truth, the sensor frame and detection a Measurement is made of, Estimate (Scan: scan.hpp, TrackSet: tracks.hpp).
 #pragma once
 
 #include <Eigen/Core>
 #include <cstdint>
+#include <cstring>
 
 namespace trackflow {
 
@@ -23,10 +24,13 @@ using Vec6 = Eigen::Matrix<double, 6, 1>;
 using Mat3 = Eigen::Matrix3d;
 using Mat6 = Eigen::Matrix<double, 6, 6>;
 
-enum class ItemKind : std::uint8_t { Truth = 1, Measurement = 2, Estimate = 4 };
+// Scan: one look of one sensor with 0..N detections (scan.hpp); Tracks: a tracker's TrackSet (tracks.hpp).
+enum class ItemKind : std::uint8_t { Truth = 1, Measurement = 2, Estimate = 4, Scan = 8, Tracks = 16 };
 using ItemMask = std::uint8_t;
 constexpr ItemMask mask(ItemKind k) { return static_cast<ItemMask>(k); }
 constexpr ItemMask operator|(ItemKind a, ItemKind b) { return mask(a) | mask(b); }
+inline constexpr ItemKind kItemKinds[] = {ItemKind::Truth, ItemKind::Measurement, ItemKind::Estimate, ItemKind::Scan,
+                                          ItemKind::Tracks};
 const char* to_string(ItemKind k);
 
 // Target state in the pipeline's local ENU frame (x east, y north, z up), metres and seconds.
@@ -53,27 +57,45 @@ enum class AzimuthConvention : std::uint8_t { NorthClockwise, XCounterClockwise 
 
 enum class MeasMode : std::uint8_t { Unknown, Skin, Beacon };
 
-struct Measurement {
-  double time = 0.0;
+// Where a sensor is and how it measures: shared by every detection of one look.
+struct SensorFrame {
   std::uint32_t sensor = 0;
   Frame frame = Frame::Spherical;
   AzimuthConvention azimuth = AzimuthConvention::NorthClockwise;
-  MeasMode mode = MeasMode::Unknown;
-  bool valid = true;            // false: radar not locked / data flagged; filters coast
-  bool has_range_rate = false;  // last element of value is range rate
-  bool has_snr = false;
-  double snr_db = 0.0;
+  // sensor_axes is the identity: consumers skip the rotation, so level sensors give bit-for-bit
+  // the results they always did.
+  bool sensor_level = true;
   Vec3 sensor_position = Vec3::Zero();  // sensor location in the ENU frame
   // The sensor's own east, north and up axes (columns, in the frame's axes): its azimuth and
   // elevation are measured from its own horizon, d_sensor = sensor_axes' d_frame. A radar at a
   // geodetic site away from the frame's origin is tilted against the frame (1 deg of arc per
-  // ~111 km); sensor_level marks the identity, so consumers skip the rotation and level sensors
-  // give bit-for-bit the results they always did. Consumers that do not rotate refuse a tilted
-  // sensor (require_level_sensor, geometry.hpp).
+  // ~111 km). Consumers that do not rotate refuse a tilted sensor (require_level_sensor, geometry.hpp).
   Mat3 sensor_axes = Mat3::Identity();
-  bool sensor_level = true;
+};
+
+// Origin labels of a detection (Detection::origin), besides a truth target id. They are for
+// scoring only (track purity, set metrics): no estimator may read them.
+inline constexpr std::uint32_t kOriginUnknown = 0xFFFFFFFFu;  // recorded data: nobody knows
+inline constexpr std::uint32_t kOriginClutter = 0xFFFFFFFEu;  // a false alarm of a simulation
+
+// What a sensor reported about one object in one look, in its SensorFrame.
+struct Detection {
+  MeasMode mode = MeasMode::Unknown;
+  bool has_range_rate = false;  // last element of value is range rate
+  bool has_snr = false;
+  double snr_db = 0.0;
+  std::uint32_t origin = kOriginUnknown;  // the truth target id that caused it, or kOriginClutter
   MeasVec value;
   MeasCov covariance;
+};
+
+// One detection with its sensor frame and time: the single-detection shorthand every filter,
+// converter and sink takes. A const Measurement& binds to const SensorFrame& and const
+// Detection& without a copy, so the per-track estimators (estimator.hpp) see scans and
+// measurements alike.
+struct Measurement : SensorFrame, Detection {
+  double time = 0.0;
+  bool valid = true;  // false: radar not locked / data flagged; filters coast
 
   int position_dim() const { return 3; }
 };
@@ -86,6 +108,12 @@ struct StateComponent {
 struct StateLayout {
   const StateComponent* components = nullptr;
   int dim = 0;
+  // Position of the component named `name`, or -1: sinks look state up by name, never by index.
+  int index_of(const char* name) const {
+    for (int i = 0; i < dim; ++i)
+      if (components && components[i].name && std::strcmp(components[i].name, name) == 0) return i;
+    return -1;
+  }
 };
 
 // What a filter publishes after each step. Whatever the filter's own state (Cartesian CV/CA,
@@ -93,7 +121,7 @@ struct StateLayout {
 // no knowledge of the state layout.
 struct Estimate {
   double time = 0.0;
-  std::uint32_t target = 0;
+  std::uint32_t target = 0;    // the truth target a sink scores this estimate against
   bool updated = false;        // false: prediction only (coasting, invalid measurement)
   bool initialised = false;    // false while the filter is still collecting its first points
   StateVec state;

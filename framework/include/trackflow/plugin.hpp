@@ -12,7 +12,8 @@
 namespace trackflow {
 
 // Exported by every plugin; the loader compares each field with its own before calling
-// register_components, so a plugin built against another SDK is refused, not run.
+// register_components, so a plugin built against another SDK is refused, not run. abi_version
+// comes first and stays first: an older plugin's info is read no further than it.
 struct PluginInfo {
   int abi_version;
   const char* sdk_version;
@@ -20,6 +21,9 @@ struct PluginInfo {
   std::size_t sizeof_truth;
   std::size_t sizeof_measurement;
   std::size_t sizeof_estimate;
+  std::size_t sizeof_scan;
+  std::size_t sizeof_track_set;
+  std::size_t sizeof_input_info;
   std::size_t sizeof_params;
   std::size_t sizeof_component;
   void (*register_components)(Registrar&);
@@ -27,7 +31,7 @@ struct PluginInfo {
 
 inline PluginInfo make_plugin_info(const char* name, void (*fn)(Registrar&)) {
   return {kAbiVersion, kSdkVersion, name, sizeof(Truth), sizeof(Measurement), sizeof(Estimate),
-          sizeof(Params), sizeof(Component), fn};
+          sizeof(Scan), sizeof(TrackSet), sizeof(InputInfo), sizeof(Params), sizeof(Component), fn};
 }
 
 }  // namespace trackflow

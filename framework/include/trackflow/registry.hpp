@@ -29,6 +29,9 @@ struct ComponentDecl {
   // whose frames do not meet (e.g. spherical radar output into a Cartesian-only filter).
   FrameMask accepts_frames = kAnyFrame;
   FrameMask produces_frames = kAnyFrame;
+  // A source whose items come in non-decreasing time within a run (out-of-order ones refused or
+  // skipped); its consumers learn it through InputInfo::time_ordered.
+  bool time_ordered = false;
   std::function<std::unique_ptr<Component>(const Params&)> create;
 };
 

@@ -34,8 +34,7 @@ struct Attached {
     a = dynamic_cast<Adapter*>(adapter.get());
     REQUIRE(f);
     REQUIRE(a);
-    REQUIRE(noise_mismatch(a->needs(), f->noise(), f->has_covariance_access()).empty());
-    REQUIRE(f->attach(a, static_cast<int>(a->annotation_names().size())));
+    test::attach(*a, *f);
     out.attach_to(*filter);
   }
   void start_run(std::uint64_t run, Diagnostics& d) {

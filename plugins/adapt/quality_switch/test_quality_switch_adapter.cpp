@@ -66,12 +66,9 @@ struct Attached {
     a = dynamic_cast<Adapter*>(adapter.get());
     REQUIRE(f);
     REQUIRE(a);
-    REQUIRE(noise_mismatch(a->needs(), f->noise(), f->has_covariance_access()).empty());
-    REQUIRE(f->attach(a, static_cast<int>(a->annotation_names().size())));
+    test::attach(*a, *f);  // the typed contract checked, the configured noise saved, as the engine does
     out.attach_to(*filter);
-    f->save_configured_noise();  // as the engine does once the graph is built
-    f->reset_adapted_state();
-    filter->start_run({0, 1, &diag});
+    test::start_run(*filter, 0, 1, &diag);
     adapter->start_run({0, 1, &diag});
   }
   const Estimate& step(const Measurement& m) {
@@ -231,8 +228,7 @@ TEST_CASE("unlocked run start restores the filter's own q") {
   Attached s;
   for (int k = 0; k < 5; ++k) s.step(meas(0.025 * k, kR0 + 0.5 * k));
   REQUIRE(s.f->noise().process.values[0] != 7.0);  // adapted
-  s.f->reset_adapted_state();  // the engine, at the start of every run
-  s.filter->start_run({1, 1, &s.diag});
+  test::start_run(*s.filter, 1, 1, &s.diag);  // as the engine, at the start of every run
   s.adapter->start_run({1, 1, &s.diag});
   s.step(meas(0.0, 0.0, 0.0, 0.0, MeasMode::Beacon, /*valid=*/false));
   for (int i = 0; i < 3; ++i) CHECK(s.f->noise().process.values[i] == 7.0);  // q_jerk of the filter
@@ -255,8 +251,7 @@ TEST_CASE("line-of-sight q gets channel PSDs scaled") {
   auto adapter = test::make("adapt.quality_switch");
   auto* a = dynamic_cast<Adapter*>(adapter.get());
   StubFilter f;
-  REQUIRE(noise_mismatch(a->needs(), f.noise(), f.has_covariance_access()).empty());
-  REQUIRE(f.attach(a, static_cast<int>(a->annotation_names().size())));
+  test::attach(*a, f);
   test::Collector out;
   out.attach_to(f);
   Diagnostics d;

@@ -39,13 +39,12 @@ struct Track {
   explicit Track(const std::string& params = "{}") : c(test::make("filter.ekf_spherical", params)) {
     f = &dynamic_cast<Filter&>(*c);
     out.attach_to(*c);
-    f->save_configured_noise();  // as the engine does once the graph is built
+    test::save_configured_noise(*f);  // as the engine does once the graph is built
   }
   void start(std::uint64_t run = 0) {
     out.estimates.clear();
     diag = Diagnostics();
-    f->reset_adapted_state();  // as the engine does at the start of every run
-    c->start_run({run, 1, &diag});
+    test::start_run(*c, run, 1, &diag);  // as the engine does at the start of every run
   }
 };
 

@@ -303,12 +303,11 @@ TEST_CASE("adapter annotations ride on the next estimates") {
   } annotator;
   auto c = test::make("filter.kalman");
   auto& f = dynamic_cast<Filter&>(*c);
-  REQUIRE(f.attach(&annotator, 3));
+  test::attach(annotator, f);
   test::Collector out;
   out.attach_to(f);
   Diagnostics d;
-  f.reset_adapted_state();
-  f.start_run({0, 1, &d});
+  test::start_run(f, 0, 1, &d);
   f.on_measurement(cartesian(0, Vec3(1, 2, 3), 1), 0);
   REQUIRE(out.estimates.back().annotation_count == 3);
   for (int i = 0; i < 3; ++i) CHECK(std::isnan(out.estimates.back().annotations[i]));
@@ -316,8 +315,7 @@ TEST_CASE("adapter annotations ride on the next estimates") {
   CHECK(out.estimates.back().annotations[0] == 2.0);
   CHECK(std::isnan(out.estimates.back().annotations[1]));
   CHECK(out.estimates.back().annotations[2] == 0.0);
-  f.reset_adapted_state();  // the engine, at the next run
-  f.start_run({1, 1, &d});
+  test::start_run(f, 1, 1, &d);  // as the engine, at the next run
   f.on_measurement(cartesian(0, Vec3(1, 2, 3), 1), 0);
   CHECK(std::isnan(out.estimates.back().annotations[0]));
 }
@@ -325,11 +323,10 @@ TEST_CASE("adapter annotations ride on the next estimates") {
 TEST_CASE("engine restores retuned process noise before next run") {
   auto c = test::make("filter.kalman", "{ q: 1 m2/s3 }");
   auto& f = dynamic_cast<Filter&>(*c);
-  f.save_configured_noise();  // the engine, once the instance is built
+  test::save_configured_noise(f);  // the engine, once the instance is built
   Diagnostics d;
   f.start_run({0, 1, &d});
   *f.noise().process.values = 50.0;
-  f.reset_adapted_state();  // the engine, at the start of every run
-  f.start_run({1, 1, &d});
+  test::start_run(f, 1, 1, &d);  // the engine, at the start of every run
   CHECK(*f.noise().process.values == 1.0);
 }

@@ -215,6 +215,7 @@ void register_components(Registrar& r) {
   d.min_inputs = 0;
   d.max_inputs = 0;
   d.produces = mask(ItemKind::Truth);
+  d.time_ordered = true;
   d.create = [](const Params& p) { return std::make_unique<TrajectorySource>(p); };
   r.add(std::move(d));
 }

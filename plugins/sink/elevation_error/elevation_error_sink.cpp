@@ -1,5 +1,4 @@
 // Purpose: sink.elevation_error — a filter's (or a measurement stream's) elevation error against truth in degrees, max and RMS per run and over the ensemble, optionally within an elevation band, and the refraction-bias estimate's error (paper 004 Fig 5).
-#include "estimation/refraction_ekf_state.hpp"
 #include "physics/refraction.hpp"
 #include "scoring/truth_match.hpp"
 
@@ -10,6 +9,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <numbers>
 #include <string>
@@ -71,14 +71,27 @@ class ElevationErrorSink final : public Component, public FieldListCodec<Elevati
       if (!t) {
         ++scored;
         estimates_ = (in.kinds & mask(ItemKind::Estimate)) != 0;
-        if (score_bias_ && in.type != "filter.refraction_ekf")
-          throw ConfigError("score_bias reads the estimated bias from filter.refraction_ekf's state; input '" + in.node +
-                            "' is " + in.type);
+        if (score_bias_) bias_index_ = bias_component(in);
       }
     }
     if (scored != 1 || truth != 1)
       throw ConfigError("sink.elevation_error scores one filter or one measurement stream against the truth: inputs: "
                         "[kf, truth] or [radar, truth]");
+  }
+
+  // The input's state component "bias" (rad), by name: filter.refraction_ekf's b, or any
+  // filter's that names an elevation bias so.
+  static int bias_component(const InputInfo& in) {
+    const int i = in.state.index_of(kBiasName);
+    if (i < 0 || std::strcmp(in.state.components[i].unit, "rad") != 0) {
+      std::string names;
+      for (int k = 0; k < in.state.dim; ++k)
+        names += std::string(k ? ", " : "") + in.state.components[k].name + " (" + in.state.components[k].unit + ")";
+      throw ConfigError("score_bias reads the state component '" + std::string(kBiasName) +
+                        "' (rad) of its input (filter.refraction_ekf's b); input '" + in.node + "' (" + in.type +
+                        ") has " + (names.empty() ? std::string("no state layout") : "the state " + names));
+    }
+    return i;
   }
 
   void start_run(const RunContext&) override {
@@ -91,7 +104,7 @@ class ElevationErrorSink final : public Component, public FieldListCodec<Elevati
   void on_estimate(const Estimate& e, int) override {
     if (!e.initialised) return;
     Item it{e.time, e.enu.head<3>().allFinite() ? elevation_of(e.enu.head<3>() - sensor_) : NAN, sensor_, NAN};
-    if (score_bias_ && e.state.size() > refraction_ekf::kBias) it.bias = e.state(refraction_ekf::kBias);
+    if (score_bias_ && bias_index_ >= 0 && e.state.size() > bias_index_) it.bias = e.state(bias_index_);
     items_.push_back(it);
   }
 
@@ -252,6 +265,8 @@ class ElevationErrorSink final : public Component, public FieldListCodec<Elevati
   const Vec3 sensor_;
   const double tolerance_;
   const bool score_bias_;
+  static constexpr const char* kBiasName = "bias";
+  int bias_index_ = -1;  // in the input's state (set_inputs)
   const sim::ElevationBias reference_;
   bool estimates_ = true;
   std::vector<Truth> truth_;

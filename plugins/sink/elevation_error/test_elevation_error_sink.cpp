@@ -16,6 +16,7 @@ using namespace trackflow;
 namespace {
 
 constexpr double kDeg = std::numbers::pi / 180;
+constexpr int kBiasAt = 12;  // where the test layout (kLayout) has the bias
 
 // The true target at elevation el(t) = 12 - 0.1 t deg, 1000 km from the radar at the origin.
 double true_el(double t) { return (12.0 - 0.1 * t) * kDeg; }
@@ -39,7 +40,7 @@ Estimate estimate_at(double t, double error, double bias) {
   e.time = t;
   e.initialised = true;
   e.state = StateVec::Zero(13);
-  e.state(12) = bias;
+  e.state(kBiasAt) = bias;
   e.enu.setZero();
   e.enu.head<3>() = Vec3(0.0, 1e6 * std::cos(true_el(t) + error), 1e6 * std::sin(true_el(t) + error));
   return e;
@@ -65,8 +66,16 @@ Summary score(const std::string& yaml, const std::vector<InputInfo>& inputs, int
 
 const std::vector<InputInfo> kRadar = {{"radar", "sim.radar", mask(ItemKind::Measurement), {}},
                                        {"truth", "sim.trajectory", mask(ItemKind::Truth), {}}};
-const std::vector<InputInfo> kEkf = {{"ekf", "filter.refraction_ekf", mask(ItemKind::Estimate), {}},
-                                     {"truth", "sim.trajectory", mask(ItemKind::Truth), {}}};
+// A state with the bias anywhere: the sink finds it by name (InputInfo::state), not by index.
+const StateComponent kLayout[13] = {{"x", "m"},  {"vx", "m/s"}, {"vx_prev", "m/s"}, {"y", "m"},  {"vy", "m/s"},
+                                    {"vy_prev", "m/s"}, {"z", "m"}, {"vz", "m/s"}, {"vz_prev", "m/s"},
+                                    {"range", "m"}, {"azimuth", "rad"}, {"elevation", "rad"}, {"bias", "rad"}};
+InputInfo ekf_input(StateLayout layout = {kLayout, 13}) {
+  InputInfo in{"ekf", "filter.refraction_ekf", mask(ItemKind::Estimate), {}};
+  in.state = layout;
+  return in;
+}
+const std::vector<InputInfo> kEkf = {ekf_input(), {"truth", "sim.trajectory", mask(ItemKind::Truth), {}}};
 
 }  // namespace
 
@@ -111,7 +120,12 @@ TEST_CASE("bias estimate scored against the true clark bias") {
 TEST_CASE("elevation sink wiring and parameters are checked") {
   auto sink = test::make("sink.elevation_error", "{score_bias: true, refraction: clark}");
   CHECK_THROWS_WITH(sink->set_inputs({{"kf", "filter.ekf", mask(ItemKind::Estimate), {}}, kEkf[1]}),
-                    Catch::Contains("filter.refraction_ekf"));
+                    Catch::Contains("input 'kf' (filter.ekf) has no state layout"));
+  // A layout without a component named "bias", or with one in other units, is refused with what it has.
+  CHECK_THROWS_WITH(sink->set_inputs({ekf_input({kLayout, 12}), kEkf[1]}),
+                    Catch::Contains("has the state x (m), vx (m/s)") && Catch::Contains("elevation (rad)"));
+  const StateComponent metres[1] = {{"bias", "m"}};
+  CHECK_THROWS_WITH(sink->set_inputs({ekf_input({metres, 1}), kEkf[1]}), Catch::Contains("bias (m)"));
   auto plain = test::make("sink.elevation_error");
   CHECK_THROWS_WITH(plain->set_inputs({kEkf[0], kEkf[0], kEkf[1]}), Catch::Contains("one filter or one measurement"));
   CHECK_THROWS_WITH(test::make("sink.elevation_error", "score_bias: true"), Catch::Contains("truth's refraction"));

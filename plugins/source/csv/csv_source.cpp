@@ -650,6 +650,7 @@ void register_components(Registrar& r) {
   d.min_inputs = 0;
   d.max_inputs = 0;
   d.produces = mask(ItemKind::Measurement);
+  d.time_ordered = true;  // rows out of time order are refused or skipped (on_bad_row)
   d.create = [](const Params& p) { return std::make_unique<CsvSource>(p); };
   r.add(std::move(d));
 }

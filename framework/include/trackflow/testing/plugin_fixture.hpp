@@ -42,19 +42,14 @@ class PluginFixture {
 
 // Attaches `adapter` to `filter` the way the engine does: the typed contract is checked (the
 // reason is thrown, as validate would report it), then the filter's configured noise is saved.
-inline void attach(Adapter& adapter, Filter& filter) {
-  const std::string why = noise_mismatch(adapter.needs(), filter.noise(), filter.has_covariance_access());
-  if (!why.empty()) throw std::runtime_error("cannot attach: " + why);
-  if (!filter.attach(&adapter, static_cast<int>(adapter.annotation_names().size())))
-    throw std::runtime_error("cannot attach: too many adapters or annotations");
-  filter.save_configured_noise();
-}
+void attach(Adapter& adapter, Filter& filter);
+
+// What the engine does once a filter is built (attach does it too): its process noise, as
+// configured, is saved to be put back at the start of every run.
+void save_configured_noise(Filter& filter);
 
 // What the engine does at the start of a run: adapted noise restored, then start_run.
-inline void start_run(Component& c, std::uint64_t run = 0, std::uint64_t seed = 1, Diagnostics* diag = nullptr) {
-  if (auto* f = dynamic_cast<Filter*>(&c)) f->reset_adapted_state();
-  c.start_run({run, seed, diag});
-}
+void start_run(Component& c, std::uint64_t run = 0, std::uint64_t seed = 1, Diagnostics* diag = nullptr);
 
 // Records what a component emits.
 class Collector : public Component {
