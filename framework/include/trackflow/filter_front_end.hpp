@@ -43,6 +43,7 @@ struct FrontEndRunResult final : RunResult {
   std::uint64_t rejected = 0;    // the filter refused the update (it said why in a warning)
   std::uint64_t counters[kMaxCounters] = {};
   std::uint64_t refused_non_finite = 0;  // steps whose state came out non-finite: not published, track restarted
+  std::uint64_t other_target = 0;  // usable measurements whose origin is another truth target than the track's
   // Per input port (one sensor's stream each when a filter takes several): updates, the sum of
   // their NIS and of their dimensions (the NIS sum's degrees of freedom).
   static constexpr int kMaxPorts = 8;
@@ -52,8 +53,8 @@ struct FrontEndRunResult final : RunResult {
   // Its codec under mpirun (run_result_codec.hpp): one list, written and read in this order.
   template <class Self, class F>
   static void fields(Self& r, F&& f) {
-    f(r.updates, r.coasted, r.non_finite, r.rejected, r.counters, r.refused_non_finite, r.port_updates, r.port_nis,
-      r.port_dof);
+    f(r.updates, r.coasted, r.non_finite, r.rejected, r.counters, r.refused_non_finite, r.other_target, r.port_updates,
+      r.port_nis, r.port_dof);
   }
 };
 
@@ -80,6 +81,9 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
     has_time_ = false;
     non_finite_reported_ = false;
     refusal_reported_ = false;
+    has_origin_ = false;
+    other_target_reported_ = false;
+    est_.target = 0;
     run_ = FrontEndRunResult{};
     clear_innovation();
     initialised_ = derived().reset_track();
@@ -122,6 +126,7 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
              " s treated as invalid (coasted); further ones are counted in the summary");
       non_finite_reported_ = true;
     }
+    if (usable) note_origin(m);
     const bool had_time = has_time_;
     const double T = m.time - time_;
     time_ = m.time;
@@ -173,6 +178,7 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
     total_.non_finite += r.non_finite;
     total_.rejected += r.rejected;
     total_.refused_non_finite += r.refused_non_finite;
+    total_.other_target += r.other_target;
     for (int i = 0; i < FrontEndRunResult::kMaxCounters; ++i) total_.counters[i] += r.counters[i];
     for (int i = 0; i < FrontEndRunResult::kMaxPorts; ++i) {
       total_.port_updates[i] += r.port_updates[i];
@@ -187,6 +193,7 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
     if (total_.non_finite) s.metric("non_finite_skipped", static_cast<double>(total_.non_finite));
     if (total_.rejected) s.metric("updates_refused", static_cast<double>(total_.rejected));
     if (total_.refused_non_finite) s.metric("non_finite_state_refused", static_cast<double>(total_.refused_non_finite));
+    if (total_.other_target) s.metric("other_target_measurements", static_cast<double>(total_.other_target));
     for (size_t i = 0; i < spec_.counters.size() && i < FrontEndRunResult::kMaxCounters; ++i)
       s.metric(spec_.counters[i], static_cast<double>(total_.counters[i]));
     if (inputs_.size() > 1) per_sensor_summary(s);
@@ -317,6 +324,27 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
     return 3;
   }
 
+  // The track's estimates carry the truth target of its first usable measurement with a known
+  // origin (Detection::origin; simulations set it), which sinks score them against. A single-track
+  // filter fed by several targets follows none of them: said once per run, counted, not hidden.
+  void note_origin(const Detection& d, double t) {
+    if (d.origin >= kOriginClutter) return;
+    if (!has_origin_) {
+      est_.target = d.origin;
+      has_origin_ = true;
+      return;
+    }
+    if (d.origin == est_.target) return;
+    ++run_.other_target;
+    if (!other_target_reported_)
+      warn("the measurement at t=" + std::to_string(t) + " s comes from truth target " + std::to_string(d.origin) +
+           ", this track's first from target " + std::to_string(est_.target) +
+           ": one filter node follows one target, so its estimates are scored against target " +
+           std::to_string(est_.target) + "; further ones are counted as other_target_measurements");
+    other_target_reported_ = true;
+  }
+  void note_origin(const Measurement& m) { note_origin(m, m.time); }
+
   void clear_innovation() {
     est_.updated = false;
     est_.innovation.resize(0);
@@ -366,6 +394,7 @@ class FilterFrontEnd : public Filter, public RunResultCodec {
   Diagnostics* diag_ = nullptr;
   double time_ = 0.0;
   bool has_time_ = false, initialised_ = false, non_finite_reported_ = false, refusal_reported_ = false;
+  bool has_origin_ = false, other_target_reported_ = false;
   FrontEndRunResult run_, total_;
   std::vector<std::string> inputs_;  // upstream node of each input port
   mutable Estimate scratch_;  // read_covariance's, so the published estimate is never touched

@@ -37,6 +37,7 @@ class ClassicalConverter final : public Component {
     m_.has_range_rate = in.has_range_rate;
     m_.has_snr = in.has_snr;
     m_.snr_db = in.snr_db;
+    m_.origin = in.origin;
     m_.sensor_position = in.sensor_position;
     // spherical_to_enu and spherical_to_enu_jacobian (geometry.hpp) written out on one set of
     // sines and cosines, from glibc's sincos (which the compiler made of their sin and cos calls

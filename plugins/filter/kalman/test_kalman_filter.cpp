@@ -330,3 +330,47 @@ TEST_CASE("engine restores retuned process noise before next run") {
   test::start_run(f, 1, 1, &d);  // the engine, at the start of every run
   CHECK(*f.noise().process.values == 1.0);
 }
+
+// Two truth targets into one single-track filter: the track takes the first target's id (sinks
+// score its estimates against that target), and the other target's measurements are said once
+// per run and counted, never silently fused.
+TEST_CASE("two targets into one filter are said and counted") {
+  auto c = test::make("filter.kalman", "{}", "kf");
+  auto& f = dynamic_cast<Filter&>(*c);
+  test::Collector out;
+  out.attach_to(f);
+  Diagnostics d;
+  f.start_run({0, 1, &d});
+  for (int k = 0; k < 6; ++k) {
+    Measurement a = cartesian(k, Vec3(100.0 * k, 0, 0), 1);
+    a.origin = 3;
+    f.on_measurement(a, 0);
+    Measurement b = cartesian(k + 0.5, Vec3(5e4, 100.0 * k, 0), 1);
+    b.origin = k < 4 ? 8 : kOriginUnknown;  // unknown origins are neither counted nor followed
+    f.on_measurement(b, 0);
+  }
+  REQUIRE(!out.estimates.empty());
+  for (const Estimate& e : out.estimates) CHECK(e.target == 3u);
+  REQUIRE(d.warnings.size() == 1);
+  CHECK_THAT(d.warnings[0].message, Catch::Contains("t=0.5") && Catch::Contains("truth target 8") &&
+                                        Catch::Contains("first from target 3"));
+  f.merge(*f.end_run());
+  Summary s;
+  f.finish(s, {});
+  REQUIRE(s.find("other_target_measurements"));
+  CHECK(s.find("other_target_measurements")->value == 4.0);
+  // One target only: no such metric, and the estimates carry its id.
+  auto single = test::make("filter.kalman");
+  auto& g = dynamic_cast<Filter&>(*single);
+  test::Collector out2;
+  out2.attach_to(g);
+  g.start_run({0, 1, &d});
+  Measurement m = cartesian(0, Vec3::Zero(), 1);
+  m.origin = 5;
+  g.on_measurement(m, 0);
+  g.merge(*g.end_run());
+  Summary s2;
+  g.finish(s2, {});
+  CHECK(s2.find("other_target_measurements") == nullptr);
+  CHECK(out2.estimates.back().target == 5u);
+}

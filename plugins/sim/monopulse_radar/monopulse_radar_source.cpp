@@ -141,6 +141,7 @@ class MonopulseRadar final : public Component, public FieldListCodec<MonopulseRu
     ++run_.looks;
     run_.missed += !detected;
     m_.time = t.time;
+    m_.origin = t.target;  // for scoring: which truth this detection comes from
     m_.valid = detected;
     m_.value(0) = range + sigma_range_ * rng_range_.normal();
     // Measured angle = boresight (true + pointing error) + the reported offset in beamwidths.

@@ -141,6 +141,7 @@ class RadarSource final : public Component, public FieldListCodec<RadarRunResult
     const sim::TimeWindow* window = modes_.find(t.time);
     const NoiseSigmas nominal = sigmas_for(rae, window);
     m_.time = t.time;
+    m_.origin = t.target;  // for scoring: which truth this detection comes from
     m_.mode = window ? window->mode : default_mode_;
     m_.valid = unlocked_.find(t.time) == nullptr;
     m_.value(0) = rae(0) + bias_range_;
