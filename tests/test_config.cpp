@@ -194,7 +194,7 @@ TEST_CASE("nested component errors point at the nested key") {
   CHECK(e.where().column == 3);
   CHECK_THAT(e.what(), Catch::Contains("did you mean 'sigma_range'"));
   e = error_of("inner: { type: filter.test, rate: 3 m }");
-  CHECK(e.where().column == 34);
+  CHECK(e.where().column == 35);  // the value "3 m"
   CHECK_THAT(e.what(), Catch::Contains("unit dimension"));
   e = error_of("inner: { type: sink.tset }");
   CHECK_THAT(e.what(), Catch::Contains("accepted (filter): filter.test"));
