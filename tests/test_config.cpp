@@ -142,3 +142,63 @@ TEST_CASE("sites and frame_origin are parsed and checked") {
   CHECK_THAT(err("pipeline: {name: a}\n" + sites + nodes), Catch::Contains("'sites' needs 'frame_origin: <site>'"));
   CHECK(err("pipeline: {name: a, frame_origin: naro}\n" + sites + nodes) == "no error");
 }
+
+namespace {
+// Two in-memory declarations the nested parameters may name: a filter and a sink.
+struct NestedTypes {
+  ComponentDecl filter, sink;
+  ComponentTypes types;
+  NestedTypes() {
+    filter.type = "filter.test";
+    filter.kind = ComponentKind::Filter;
+    filter.params = specs();
+    sink.type = "sink.test";
+    sink.kind = ComponentKind::Sink;
+    types = {&filter, &sink};
+  }
+};
+std::vector<ParamSpec> nested_specs() {
+  return {ParamSpec::component("inner", {ComponentKind::Filter}, "one filter").req(),
+          ParamSpec::component_list("modes", {}, "filters").with_prefix("filter.").def("[]")};
+}
+}  // namespace
+
+TEST_CASE("a nested component's params are validated against its own type, in SI") {
+  NestedTypes t;
+  Value v = load_yaml_string("{ inner: { type: filter.test, rate: 2 kHz },\n"
+                             "  modes: [ { type: filter.test, rate: 1 Hz, sigma_range: 1 km } ] }",
+                             "p.yaml");
+  Params p = validate_params(nested_specs(), v, "imm", v.loc, t.types);
+  const NestedComponent& inner = p.component("inner");
+  CHECK(inner.type == "filter.test");
+  CHECK(inner.params.real("rate") == 2000.0);
+  CHECK(inner.params.real("sigma_range") == 10.0);  // the nested type's own default
+  REQUIRE(p.components("modes").size() == 1);
+  CHECK(p.components("modes")[0].params.real("sigma_range") == 1000.0);
+}
+
+TEST_CASE("nested component errors point at the nested key") {
+  NestedTypes t;
+  auto error_of = [&](const std::string& yaml) {
+    Value v = load_yaml_string(yaml, "p.yaml");
+    try {
+      validate_params(nested_specs(), v, "imm", v.loc, t.types);
+    } catch (const ConfigError& e) {
+      return e;
+    }
+    FAIL("no error for: " << yaml);
+    return ConfigError("");
+  };
+  ConfigError e = error_of("inner:\n  type: filter.test\n  rate: 1 Hz\n  sigma_rnage: 1 m\n");
+  CHECK(e.where().line == 4);
+  CHECK(e.where().column == 3);
+  CHECK_THAT(e.what(), Catch::Contains("did you mean 'sigma_range'"));
+  e = error_of("inner: { type: filter.test, rate: 3 m }");
+  CHECK(e.where().column == 35);  // the value "3 m"
+  CHECK_THAT(e.what(), Catch::Contains("unit dimension"));
+  e = error_of("inner: { type: sink.tset }");
+  CHECK_THAT(e.what(), Catch::Contains("accepted (filter): filter.test"));
+  e = error_of("inner: { type: filter.test, rate: 1 Hz }\nmodes: [ { type: sink.test } ]");
+  CHECK(e.where().line == 2);
+  CHECK_THAT(e.what(), Catch::Contains("not accepted here"));
+}

@@ -41,6 +41,8 @@ Graph build_graph(PipelineConfig cfg, const PluginRegistry& registry) {
     ids.push_back(g.config.nodes[i].id);
   }
   bool sites_used = false;
+  ComponentTypes types;  // what Component parameters may name
+  for (const auto& t : registry.types()) types.push_back(&t.decl);
   for (const auto& nc : g.config.nodes) {
     GraphNode n;
     n.config = nc;
@@ -69,7 +71,7 @@ Graph build_graph(PipelineConfig cfg, const PluginRegistry& registry) {
       inject("sites", g.config.sites, g.config.sites.loc);
     }
     if (g.config.frame_origin.is_scalar()) inject("frame_origin", g.config.frame_origin, g.config.frame_origin.loc);
-    n.params = validate_params(d.params, params, nc.id, nc.loc);
+    n.params = validate_params(d.params, params, nc.id, nc.loc, types);
     for (size_t k = 0; k < nc.inputs.size(); ++k) {
       const auto& in = nc.inputs[k];
       auto it = index.find(in);

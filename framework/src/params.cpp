@@ -12,6 +12,8 @@ const char* to_string(ParamType t) {
     case ParamType::Choice: return "choice";
     case ParamType::RealList: return "list of reals";
     case ParamType::Records: return "list of records";
+    case ParamType::Component: return "component";
+    case ParamType::ComponentList: return "list of components";
   }
   return "?";
 }
@@ -58,6 +60,17 @@ ParamSpec ParamSpec::records(std::string name, std::vector<ParamSpec> fields, st
   return s;
 }
 
+ParamSpec ParamSpec::component(std::string name, std::vector<ComponentKind> kinds, std::string doc) {
+  auto s = make(std::move(name), ParamType::Component, std::move(doc));
+  s.kinds = std::move(kinds);
+  return s;
+}
+ParamSpec ParamSpec::component_list(std::string name, std::vector<ComponentKind> kinds, std::string doc) {
+  auto s = make(std::move(name), ParamType::ComponentList, std::move(doc));
+  s.kinds = std::move(kinds);
+  return s;
+}
+
 ParamValue::ParamValue() = default;
 ParamValue::ParamValue(const ParamValue&) = default;
 ParamValue::ParamValue(ParamValue&&) noexcept = default;
@@ -85,6 +98,13 @@ const std::string& Params::text(std::string_view n) const { return get(n, ParamT
 const std::string& Params::choice_word(std::string_view n) const { return get(n, ParamType::Choice).text; }
 const std::vector<double>& Params::reals(std::string_view n) const { return get(n, ParamType::RealList).reals; }
 const std::vector<Params>& Params::records(std::string_view n) const { return get(n, ParamType::Records).records; }
+
+const NestedComponent& Params::component(std::string_view n) const {
+  return get(n, ParamType::Component).components.front();  // validation makes exactly one
+}
+const std::vector<NestedComponent>& Params::components(std::string_view n) const {
+  return get(n, ParamType::ComponentList).components;
+}
 
 Vec3 Params::vec3(std::string_view n) const {
   const auto& r = reals(n);

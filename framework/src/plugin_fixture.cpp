@@ -28,7 +28,9 @@ Params PluginFixture::params_for(const std::string& type, const std::string& yam
   const host::RegisteredType* t = state_->registry.find(type);
   if (!t) throw std::runtime_error("no plugin declares type '" + type + "'");
   const host::Value v = host::load_yaml_string(yaml_params, "test params");
-  return host::validate_params(t->decl.params, v, node_id, v.loc);
+  host::ComponentTypes types;
+  for (const auto& r : state_->registry.types()) types.push_back(&r.decl);
+  return host::validate_params(t->decl.params, v, node_id, v.loc, types);
 }
 
 std::shared_ptr<Component> PluginFixture::make(const std::string& type, const std::string& yaml_params,

@@ -44,7 +44,60 @@ double parse_real(const ParamSpec& s, const Value& v, const std::string& node) {
   return q.value;
 }
 
-ParamValue parse_value(const ParamSpec& s, const Value& v, const std::string& node) {
+bool accepts(const ParamSpec& s, const ComponentDecl& d) {
+  const bool kind_ok = s.kinds.empty() || std::find(s.kinds.begin(), s.kinds.end(), d.kind) != s.kinds.end();
+  return kind_ok && d.type.rfind(s.type_prefix, 0) == 0;
+}
+
+// What a Component parameter accepts, for describe and messages: "filter", "filter, type filter.*".
+std::string accepted_text(const ParamSpec& s) {
+  std::vector<std::string> parts;
+  std::vector<std::string> k;
+  for (ComponentKind kind : s.kinds) k.push_back(to_string(kind));
+  if (!k.empty()) parts.push_back(join(k, "/"));
+  if (!s.type_prefix.empty()) parts.push_back("type " + s.type_prefix + "*");
+  return parts.empty() ? "any type" : join(parts, ", ");
+}
+
+// One `{type: <name>, <params>...}` map: the type must be a loaded one that the spec accepts; the
+// other keys are that type's params, validated by validate_params itself, so a nested key's error
+// has the nested key's own file:line:col as any top-level one.
+NestedComponent parse_component(const ParamSpec& s, const Value& v, const std::string& node,
+                                const ComponentTypes& types) {
+  if (v.kind != Value::Kind::Map)
+    throw ConfigError("parameter '" + s.name + "' expects a map {type: <" + accepted_text(s) + ">, <its parameters>}, got " +
+                          v.describe(),
+                      v.loc, node);
+  const Value* type = v.find("type");
+  if (!type) throw ConfigError("parameter '" + s.name + "': the component map has no 'type'", v.loc, node);
+  if (!type->is_scalar())
+    throw ConfigError("parameter '" + s.name + "': 'type' must be a type name, got " + type->describe(), type->loc, node);
+  std::vector<std::string> names;
+  const ComponentDecl* decl = nullptr;
+  for (const ComponentDecl* d : types) {
+    if (!accepts(s, *d)) continue;
+    names.push_back(d->type);
+    if (d->type == type->scalar) decl = d;
+  }
+  if (!decl) {
+    const bool exists = std::any_of(types.begin(), types.end(), [&](const ComponentDecl* d) { return d->type == type->scalar; });
+    throw ConfigError("parameter '" + s.name + "': " +
+                          (exists ? "type '" + quote_token(type->scalar) + "' is not accepted here"
+                                  : "unknown type '" + quote_token(type->scalar) + "'" + did_you_mean(type->scalar, names)) +
+                          "; accepted (" + accepted_text(s) + "): " + (names.empty() ? std::string("none loaded") : join(names)),
+                      type->loc, node);
+  }
+  Value rest = v;
+  for (size_t i = 0; i < rest.entries.size(); ++i)
+    if (rest.entries[i].first == "type") {
+      rest.entries.erase(rest.entries.begin() + static_cast<std::ptrdiff_t>(i));
+      rest.key_locs.erase(rest.key_locs.begin() + static_cast<std::ptrdiff_t>(i));
+      break;
+    }
+  return {decl->type, validate_params(decl->params, rest, node, v.loc, types), type->loc};
+}
+
+ParamValue parse_value(const ParamSpec& s, const Value& v, const std::string& node, const ComponentTypes& types) {
   ParamValue out;
   out.type = s.type;
   out.where = v.loc;
@@ -109,8 +162,16 @@ ParamValue parse_value(const ParamSpec& s, const Value& v, const std::string& no
       for (const auto& item : v.items) {
         if (item.kind != Value::Kind::Map)
           throw ConfigError("each entry of '" + s.name + "' must be a map, got " + item.describe(), item.loc, node);
-        out.records.push_back(validate_params(s.fields, item, node, item.loc));
+        out.records.push_back(validate_params(s.fields, item, node, item.loc, types));
       }
+      break;
+    }
+    case ParamType::Component:
+      out.components.push_back(parse_component(s, v, node, types));
+      break;
+    case ParamType::ComponentList: {
+      if (v.kind != Value::Kind::List) throw type_error();
+      for (const auto& item : v.items) out.components.push_back(parse_component(s, item, node, types));
       break;
     }
   }
@@ -126,12 +187,14 @@ std::string describe_type(const ParamSpec& s) {
       return (s.list_size >= 0 ? "list of " + std::to_string(s.list_size) : std::string("list of")) + " reals [" +
              s.dimension.str() + "]";
     case ParamType::Choice: return "choice {" + join(s.choices, "|") + "}";
+    case ParamType::Component: return "component {type: " + accepted_text(s) + "}";
+    case ParamType::ComponentList: return "list of components {type: " + accepted_text(s) + "}";
     default: return to_string(s.type);
   }
 }
 
 Params validate_params(const std::vector<ParamSpec>& specs, const Value& given, const std::string& node,
-                       const SourceLoc& node_loc) {
+                       const SourceLoc& node_loc, const ComponentTypes& types) {
   Params p(node, given.kind == Value::Kind::Null ? node_loc : given.loc);
   std::vector<std::string> names;
   for (const auto& s : specs) names.push_back(s.name);
@@ -144,10 +207,10 @@ Params validate_params(const std::vector<ParamSpec>& specs, const Value& given, 
   }
   for (const auto& s : specs) {
     if (const Value* v = given.find(s.name)) {
-      p.set(s.name, parse_value(s, *v, node));
+      p.set(s.name, parse_value(s, *v, node, types));
     } else if (!s.default_text.empty()) {
       Value dv = load_yaml_string(s.default_text, "default of " + s.name);
-      ParamValue pv = parse_value(s, dv, node);
+      ParamValue pv = parse_value(s, dv, node, types);
       pv.from_default = true;
       p.set(s.name, std::move(pv));
     } else if (s.required) {

@@ -14,6 +14,9 @@
 
 namespace trackflow {
 
+// Declared in registry.hpp (which includes this header); a scoped enum's opaque declaration is complete.
+enum class ComponentKind;
+
 enum class ParamType {
   Real,      // a quantity with a dimension: "10 m", "3 mrad", 0.5
   Integer,
@@ -22,6 +25,8 @@ enum class ParamType {
   Choice,    // one of a fixed list of words
   RealList,  // [1, 2, 3] or [1 km, 2 km]; each element has the declared dimension
   Records,   // a list of maps, each validated against `fields` (e.g. trajectory segments)
+  Component,      // one nested component: {type: filter.ekf, <that type's params>...}
+  ComponentList,  // a list of such maps
 };
 const char* to_string(ParamType t);
 
@@ -39,6 +44,10 @@ struct ParamSpec {
   double min = -std::numeric_limits<double>::infinity();  // SI, inclusive
   double max = std::numeric_limits<double>::infinity();
   int list_size = -1;             // RealList: exact length when >= 0
+  // Component and ComponentList: the types a nested map may name. Empty kinds: any kind; empty
+  // prefix: any name. Its params are validated against that type's own declaration.
+  std::vector<ComponentKind> kinds;
+  std::string type_prefix;
 
   // Fluent construction, e.g.
   //   ParamSpec::real("sigma_range", dim::length, "range noise σ").def("10 m").at_least(0)
@@ -66,6 +75,12 @@ struct ParamSpec {
   // A choice read only as its word (choice_word); prefer the typed form above.
   static ParamSpec choice_words(std::string name, std::vector<std::string> choices, std::string doc);
   static ParamSpec records(std::string name, std::vector<ParamSpec> fields, std::string doc);
+  // A nested component of one of `kinds`, e.g. ParamSpec::component("motion_filter", {ComponentKind::Filter}, "...");
+  // the plugin reads it as p.component(name) and may ask the host to create it.
+  static ParamSpec component(std::string name, std::vector<ComponentKind> kinds, std::string doc);
+  static ParamSpec component_list(std::string name, std::vector<ComponentKind> kinds, std::string doc);
+  // Only types whose name starts with `prefix` ("filter.").
+  ParamSpec with_prefix(std::string prefix) && { type_prefix = std::move(prefix); return std::move(*this); }
   ParamSpec def(std::string text) && { default_text = std::move(text); return std::move(*this); }
   ParamSpec req() && { required = true; return std::move(*this); }
   ParamSpec at_least(double v) && { min = v; return std::move(*this); }
@@ -74,6 +89,7 @@ struct ParamSpec {
 };
 
 class Params;
+struct NestedComponent;
 
 struct ParamValue {
   ParamType type = ParamType::Real;
@@ -84,6 +100,7 @@ struct ParamValue {
   std::string text;
   std::vector<double> reals;
   std::vector<Params> records;
+  std::vector<NestedComponent> components;  // Component: exactly one; ComponentList: each entry
   SourceLoc where;
   bool from_default = false;
 
@@ -114,6 +131,8 @@ class Params {
   const std::vector<double>& reals(std::string_view name) const;
   Vec3 vec3(std::string_view name) const;                // RealList of size 3
   const std::vector<Params>& records(std::string_view name) const;
+  const NestedComponent& component(std::string_view name) const;               // Component only
+  const std::vector<NestedComponent>& components(std::string_view name) const;  // ComponentList only
   double real_or(std::string_view name, double fallback) const { return has(name) ? real(name) : fallback; }
 
   bool has(std::string_view name) const;    // a value exists (given or defaulted)
@@ -133,6 +152,14 @@ class Params {
   std::string node_;
   SourceLoc where_;
   std::vector<std::pair<std::string, ParamValue>> values_;
+};
+
+// A validated nested component: the type named by its `type:` key and its other keys, validated
+// against that type's declaration (units converted to SI as for any node).
+struct NestedComponent {
+  std::string type;
+  Params params;
+  SourceLoc type_where;  // the `type:` value, for messages about the type itself
 };
 
 }  // namespace trackflow

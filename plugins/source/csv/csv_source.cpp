@@ -193,7 +193,9 @@ std::string cache_key(const Params& p, const fs::path& path) {
           key += buf;
         }
         break;
-      case ParamType::Records: break;
+      case ParamType::Records:
+      case ParamType::Component:
+      case ParamType::ComponentList: break;
     }
     key += '\n';
   }
