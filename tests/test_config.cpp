@@ -163,7 +163,7 @@ std::vector<ParamSpec> nested_specs() {
 }
 }  // namespace
 
-TEST_CASE("a nested component's params are validated against its own type, in SI") {
+TEST_CASE("nested params are checked by their own type, in SI") {
   NestedTypes t;
   Value v = load_yaml_string("{ inner: { type: filter.test, rate: 2 kHz },\n"
                              "  modes: [ { type: filter.test, rate: 1 Hz, sigma_range: 1 km } ] }",
