@@ -1,8 +1,8 @@
-// Purpose: filter.alpha_beta — example third-party plugin: the classic fixed-gain α-β tracker on each ENU axis.
+// Purpose: filter.alpha_beta — example third-party plugin: the classic fixed-gain α-β tracker on each ENU axis, as a per-track estimator (a filter node, and what a tracker runs per track).
 #include "alpha_beta_gains.hpp"
 
-#include <trackflow/filter_front_end.hpp>
 #include <trackflow/plugin.hpp>
+#include <trackflow/single_track_filter.hpp>
 
 #include <cmath>
 #include <string>
@@ -16,18 +16,16 @@ using namespace trackflow;
 // actual T = t_k − t_{k−1} of each step. Two-point start: the first measurement gives the
 // position, the second the velocity by difference. The published covariance is the α-β
 // steady state (alpha_beta_gains.hpp) for the measurement's own variance on that axis.
-// The SDK's front end (FilterFrontEnd) does everything around that: validity and frame checks,
-// time order, R from the measurement, adapter hooks, coasting, publishing and counting.
-class AlphaBetaFilter final : public FilterFrontEnd<AlphaBetaFilter> {
-  friend FilterFrontEnd<AlphaBetaFilter>;
-
+// This class is one track's estimator (trackflow/estimator.hpp). The SDK's SingleTrackFilter
+// (single_track_filter.hpp) makes it a filter node and does everything around it: validity and
+// frame checks, time order, R from the measurement, adapter hooks, coasting, publishing and
+// counting; a multi-target tracker clones it for every track it starts.
+class AlphaBetaEstimator final : public Estimator {
  public:
-  AlphaBetaFilter(alpha_beta::Gains gains, std::string node)
-      : FilterFrontEnd(FrontEndSpec{"filter.alpha_beta", std::move(node), Frame::Cartesian, RangeRateUse::Ignore, {}}),
-        gains_(gains) {
-    est_.state.resize(6);
-    est_.covariance.resize(6, 6);
-  }
+  explicit AlphaBetaEstimator(alpha_beta::Gains gains)
+      : Estimator(MeasurementSpec{Frame::Cartesian, RangeRateUse::Ignore, {}}), gains_(gains) {}
+
+  std::unique_ptr<Estimator> clone() const override { return std::make_unique<AlphaBetaEstimator>(*this); }
 
   // Adapters may replace R before each update; the gains themselves are fixed, so there is no
   // process noise to expose.
@@ -37,20 +35,20 @@ class AlphaBetaFilter final : public FilterFrontEnd<AlphaBetaFilter> {
     return h;
   }
 
-  StateLayout state_layout() const override {
+  StateLayout layout() const override {
     static constexpr StateComponent kLayout[] = {{"x", "m"}, {"vx", "m/s"}, {"y", "m"},
                                                  {"vy", "m/s"}, {"z", "m"}, {"vz", "m/s"}};
     return {kLayout, 6};
   }
 
  private:
-  bool reset_track() {
+  bool reset() override {
     has_first_ = false;
     return false;
   }
 
   // Two-point differencing: var(x) = σ₂², cov(x, v) = σ₂²/T, var(v) = (σ₁² + σ₂²)/T².
-  bool initialise(const Measurement& m, int) {
+  bool initiate(const Measurement& m, int) override {
     const Vec3 z = m.value.head<3>();
     const double T = m.time - first_time_;
     if (!has_first_ || !(T > 0.0)) {
@@ -73,7 +71,7 @@ class AlphaBetaFilter final : public FilterFrontEnd<AlphaBetaFilter> {
 
   // The α-β model has no process noise, so while coasting the covariance grows only by F P F'
   // (an optimistic bound).
-  void predict(double T) {
+  void predict(double T) override {
     T_ = T;
     position_ += T * velocity_;
     for (int a = 0; a < 3; ++a) {
@@ -82,8 +80,16 @@ class AlphaBetaFilter final : public FilterFrontEnd<AlphaBetaFilter> {
     }
   }
 
-  template <int M>
-  bool update(const Measurement& m) {
+  // z^ = the predicted position; S per axis from the alpha-beta steady state for R's variance.
+  bool predict_measurement(const SensorFrame&, const MeasCov& R, PredictedMeasurement& p) const override {
+    if (!(T_ > 0.0) || R.rows() != 3) return false;
+    p.z = position_;
+    p.S = MeasCov::Zero(3, 3);
+    for (int a = 0; a < 3; ++a) p.S(a, a) = alpha_beta::steady_state_covariance(gains_, T_, R(a, a)).s;
+    return set_log_det(p);
+  }
+
+  bool update(const Measurement& m, int) override {
     if (!(T_ > 0.0)) {
       warn("measurement at t=" + std::to_string(m.time) + " s is not later than the track; not used");
       return false;
@@ -113,14 +119,14 @@ class AlphaBetaFilter final : public FilterFrontEnd<AlphaBetaFilter> {
     return true;
   }
 
-  void scale_state_covariance(double k) {
+  void scale_covariance(double k) override {
     p11_ *= k;
     p12_ *= k;
     p22_ *= k;
   }
 
   // state [x vx y vy z vz]; enu [x y z vx vy vz]; axes are uncorrelated in the α-β model.
-  void fill_estimate(Estimate& e) const {
+  void fill(Estimate& e) const override {
     e.covariance.setZero();
     e.enu_covariance.setZero();
     for (int a = 0; a < 3; ++a) {
@@ -190,8 +196,12 @@ void register_components(Registrar& r) {
                       "instead of alpha and beta: Kalata's Lambda = sigma_accel T^2 / sigma_measurement")
           .positive(),
   };
+  // One estimator, two uses: the filter node, and the estimator a tracker runs per track.
   d.create = [](const Params& p) -> std::unique_ptr<Component> {
-    return std::make_unique<AlphaBetaFilter>(gains_from(p), p.node());
+    return make_single_track_filter("filter.alpha_beta", p.node(), AlphaBetaEstimator(gains_from(p)));
+  };
+  d.create_estimator = [](const Params& p) -> std::unique_ptr<Estimator> {
+    return std::make_unique<AlphaBetaEstimator>(gains_from(p));
   };
   r.add(std::move(d));
 }

@@ -335,3 +335,44 @@ TEST_CASE("fading memory scales P by alpha squared before each update") {
   } wants_spherical_r;
   CHECK_THROWS_WITH(testing::attach(wants_spherical_r, filter), Catch::Contains("spherical"));
 }
+
+// The same estimator, unchanged, as a tracker takes it (fixture.make_estimator: the declaration's
+// create_estimator): run per track through a TrackContext, its predicted measurement is the z^ and
+// S of the update that follows, and a clone continues exactly as the original.
+TEST_CASE("estimator alone runs per track and predicts") {
+  struct Track final : TrackContext {
+    void warn(const std::string&) override {}
+    void count(int) override {}
+    void annotate(int, double) override {}
+    Estimate e;
+  } track;
+  track.estimate = &track.e;
+  auto est = fixture().make_estimator("filter.alpha_beta", "{alpha: 0.6, beta: 0.3}");
+  est->bind(track);
+  const Vec3 var(4.0, 9.0, 16.0);
+  CHECK_FALSE(est->reset());
+  est->measurement_noise() = cartesian(0.0, Vec3::Zero(), var).covariance;
+  CHECK_FALSE(est->initiate(cartesian(0.0, Vec3(0, 0, 0), var), 3));
+  CHECK(est->initiate(cartesian(1.0, Vec3(10, 20, -5), var), 3));
+  const Measurement m = cartesian(3.0, Vec3(25, 35, -5), var);
+  track.time = m.time;
+  est->predict(2.0);
+  PredictedMeasurement p;
+  REQUIRE(est->predict_measurement(m, m.covariance, p));
+  CHECK(p.z == Vec3(30, 60, -15));  // z2 + T v2
+  std::unique_ptr<Estimator> copy = est->clone();
+  REQUIRE(est->update(m, 3));
+  REQUIRE(track.e.updated);
+  for (int a = 0; a < 3; ++a) {
+    CHECK(track.e.innovation(a) == Approx(m.value(a) - p.z(a)));
+    CHECK(track.e.innovation_covariance(a, a) == Approx(p.S(a, a)));
+    CHECK(p.S(a, a) == Approx(var(a) / (1 - 0.6)));
+  }
+  CHECK(p.log_det_S == Approx(std::log(p.S.determinant())));
+  Estimate a, b;
+  est->fill(a);
+  REQUIRE(copy->update(m, 3));
+  copy->fill(b);
+  CHECK(a.state == b.state);
+  CHECK(a.covariance == b.covariance);
+}

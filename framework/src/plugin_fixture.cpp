@@ -44,6 +44,12 @@ std::shared_ptr<Component> PluginFixture::make(const std::string& type, const st
   return c;
 }
 
+std::shared_ptr<Estimator> PluginFixture::make_estimator(const std::string& type, const std::string& yaml_params,
+                                                        const std::string& node_id) const {
+  const host::PluginRegistry& registry = state_->registry;
+  return registry.create_estimator(*registry.find(type), params_for(type, yaml_params, node_id));
+}
+
 void attach(Adapter& adapter, Filter& filter) {
   const std::string why = noise_mismatch(adapter.needs(), filter.noise(), filter.has_covariance_access());
   if (!why.empty()) throw std::runtime_error("cannot attach: " + why);

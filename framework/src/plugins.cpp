@@ -180,6 +180,21 @@ std::shared_ptr<Component> PluginRegistry::create(const RegisteredType& t, const
   return std::shared_ptr<Component>(c.release(), [lib](Component* ptr) { delete ptr; });
 }
 
+std::shared_ptr<Estimator> PluginRegistry::create_estimator(const RegisteredType& t, const Params& p) const {
+  if (!t.decl.create_estimator) {
+    std::string with;
+    for (const RegisteredType& r : types())
+      if (r.decl.create_estimator) with += (with.empty() ? "" : ", ") + r.decl.type;
+    throw ConfigError("'" + t.decl.type + "' declares no per-track estimator; types that do: " +
+                          (with.empty() ? std::string("none loaded") : with),
+                      p.where(), p.node());
+  }
+  std::unique_ptr<Estimator> e = t.decl.create_estimator(p);
+  if (!e) throw ConfigError("estimator factory of '" + t.decl.type + "' returned nothing", p.where(), p.node());
+  auto lib = t.library;
+  return std::shared_ptr<Estimator>(e.release(), [lib](Estimator* ptr) { delete ptr; });
+}
+
 std::vector<std::string> environment_plugin_dirs() {
   std::vector<std::string> dirs;
   if (const char* env = std::getenv("TRACKFLOW_PLUGIN_PATH")) {

@@ -2,6 +2,7 @@
 #pragma once
 
 #include <trackflow/component.hpp>
+#include <trackflow/estimator.hpp>
 #include <trackflow/params.hpp>
 
 #include <functional>
@@ -33,6 +34,9 @@ struct ComponentDecl {
   // skipped); its consumers learn it through InputInfo::time_ordered.
   bool time_ordered = false;
   std::function<std::unique_ptr<Component>(const Params&)> create;
+  // A filter whose state estimator runs per track (estimator.hpp): the same parameters make the
+  // estimator alone, which a tracker (or filter.imm, as a mode) clones for each track it starts.
+  std::function<std::unique_ptr<Estimator>(const Params&)> create_estimator;
 };
 
 class Registrar {

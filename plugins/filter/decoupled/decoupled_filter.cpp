@@ -2,7 +2,7 @@
 #include "decoupled_cv.hpp"
 
 #include <trackflow/estimate_state.hpp>
-#include <trackflow/filter_front_end.hpp>
+#include <trackflow/single_track_filter.hpp>
 #include <trackflow/motion.hpp>
 #include <trackflow/plugin.hpp>
 
@@ -23,15 +23,12 @@ struct DecoupledSettings {
 };
 
 // The measurement front end is the SDK's (filter_front_end.hpp); this class is the model.
-class DecoupledFilter final : public FilterFrontEnd<DecoupledFilter> {
-  friend FilterFrontEnd<DecoupledFilter>;
+class DecoupledEstimator final : public Estimator {
 
  public:
-  explicit DecoupledFilter(DecoupledSettings s)
-      : FilterFrontEnd(FrontEndSpec{"filter.decoupled", s.node, Frame::Cartesian, RangeRateUse::Ignore, {}}),
+  explicit DecoupledEstimator(DecoupledSettings s)
+      : Estimator(MeasurementSpec{Frame::Cartesian, RangeRateUse::Ignore, {}}),
         s_(std::move(s)) {
-    est_.state.resize(6);
-    est_.covariance.resize(6, 6);
     for (int a = 0; a < 3; ++a) {
       idx_[a] = decoupled::pos(a);
       idx_[a + 3] = decoupled::vel(a);
@@ -50,14 +47,14 @@ class DecoupledFilter final : public FilterFrontEnd<DecoupledFilter> {
     return h;
   }
 
-  StateLayout state_layout() const override {
+  StateLayout layout() const override {
     static constexpr StateComponent kLayout[] = {{"x", "m"}, {"vx", "m/s"}, {"y", "m"},
                                                  {"vy", "m/s"}, {"z", "m"}, {"vz", "m/s"}};
     return {kLayout, 6};
   }
 
  private:
-  bool reset_track() {
+  bool reset() override {
     has_first_ = false;
     last_T_ = -1.0;
     last_q_ = -1.0;
@@ -65,7 +62,7 @@ class DecoupledFilter final : public FilterFrontEnd<DecoupledFilter> {
     return false;
   }
 
-  void predict(double T) {
+  void predict(double T) override {
     const double q = s_.q;
     if (!same_interval(T, last_T_) || q != last_q_) {  // an adapter may retune q between steps
       Q_axis_ = s_.noise == DecoupledSettings::Noise::Continuous ? ConstantVelocity::axis_noise_continuous(T, q)
@@ -76,8 +73,16 @@ class DecoupledFilter final : public FilterFrontEnd<DecoupledFilter> {
     f_.predict(T, Q_axis_);
   }
 
+  bool update(const Measurement& m, int dim) override {
+    return dim == 4 ? update_values<4>(m) : update_values<3>(m);
+  }
+  bool predict_measurement(const SensorFrame& s, const MeasCov& R, PredictedMeasurement& p) const override {
+    return predicted_by_update<DecoupledEstimator>(s, R, p);
+  }
+  std::unique_ptr<Estimator> clone() const override { return std::make_unique<DecoupledEstimator>(*this); }
+
   template <int M>
-  bool update(const Measurement& m) {
+  bool update_values(const Measurement& m) {
     const Vec3 z = m.value.head<3>();
     Mat3 next = f_.D;
     if (decoupled::line_of_sight_frame(z - m.sensor_position, next)) {
@@ -96,11 +101,11 @@ class DecoupledFilter final : public FilterFrontEnd<DecoupledFilter> {
     return false;
   }
 
-  void scale_state_covariance(double k) {
+  void scale_covariance(double k) override {
     for (auto& B : f_.P) B *= k;
   }
 
-  bool initialise(const Measurement& m, int) {
+  bool initiate(const Measurement& m, int) override {
     const Vec3 z = m.value.head<3>();
     const Mat3 R = R_.topLeftCorner(3, 3);
     const double T = m.time - t1_;
@@ -117,7 +122,7 @@ class DecoupledFilter final : public FilterFrontEnd<DecoupledFilter> {
     return true;
   }
 
-  void fill_estimate(Estimate& e) {
+  void fill(Estimate& e) const override {
     f_.cartesian_covariance(P_);
     set_estimate_state(e, f_.x, P_, idx_);
   }
@@ -126,7 +131,7 @@ class DecoupledFilter final : public FilterFrontEnd<DecoupledFilter> {
   DecoupledCv f_;
   decoupled::UpdateResult result_;
   decoupled::Mat2 Q_axis_ = decoupled::Mat2::Zero();
-  Mat6 P_ = Mat6::Zero();
+  mutable Mat6 P_ = Mat6::Zero();  // fill's ENU covariance (fill is const: a product, no state)
   double last_T_ = -1.0, last_q_ = -1.0;
   bool has_first_ = false;
   Vec3 z1_ = Vec3::Zero();
@@ -135,7 +140,8 @@ class DecoupledFilter final : public FilterFrontEnd<DecoupledFilter> {
   int idx_[6] = {};
 };
 
-std::unique_ptr<Component> create(const Params& p) {
+// The estimator of one track from the node's parameters (the node and a tracker take it alike).
+DecoupledEstimator make_estimator(const Params& p) {
   DecoupledSettings s;
   s.node = p.node();
   if (p.given("sigma_accel") && p.given("q"))
@@ -147,8 +153,14 @@ std::unique_ptr<Component> create(const Params& p) {
     s.q = p.real("q");
   }
   s.reproject = p.choice<FrameChange>("frame_change") == FrameChange::Reproject;
-  return std::make_unique<DecoupledFilter>(s);
+  return DecoupledEstimator(s);
 }
+
+std::unique_ptr<Component> create(const Params& p) {
+  return make_single_track_filter("filter.decoupled", p.node(), make_estimator(p));
+}
+
+std::unique_ptr<Estimator> create_estimator(const Params& p) { return std::make_unique<DecoupledEstimator>(make_estimator(p)); }
 
 const char* const kDoc =
     "Paper 001 eq 21-27 (Kim & Hwang 2013, after Fitzgerald 1985). State [x vx y vy z vz] in ENU, constant "
@@ -188,6 +200,7 @@ void register_components(Registrar& r) {
           .def("reproject"),
   };
   d.create = create;
+  d.create_estimator = create_estimator;
   r.add(std::move(d));
 }
 

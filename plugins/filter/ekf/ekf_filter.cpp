@@ -1,21 +1,22 @@
 // Purpose: filter.ekf — extended Kalman filter with a Cartesian ENU state (CV, CA or Singer motion) on spherical [r, az, el(, rdot)] measurements.
-#include "estimation/cartesian_radar_filter.hpp"
+#include "estimation/cartesian_radar_estimator.hpp"
 #include "estimation/ekf_radar_update.hpp"
 
 #include <trackflow/geometry.hpp>
 #include <trackflow/plugin.hpp>
+#include <trackflow/single_track_filter.hpp>
 
 #include <string>
 
 namespace trackflow {
 namespace {
 
-// Settings, measurement checks, initialisation, prediction and publishing: cartesian_radar_filter.hpp.
+// Settings, measurement checks, initialisation, prediction and publishing: cartesian_radar_estimator.hpp.
 // This class is the EKF update: h linearised at the predicted state.
 template <int Order>
 class ExtendedKalmanFilter final
-    : public cartesian_filter::CartesianRadarFilter<Order, ExtendedKalmanFilter<Order>> {
-  using Base = cartesian_filter::CartesianRadarFilter<Order, ExtendedKalmanFilter<Order>>;
+    : public cartesian_filter::CartesianRadarEstimator<Order, ExtendedKalmanFilter<Order>> {
+  using Base = cartesian_filter::CartesianRadarEstimator<Order, ExtendedKalmanFilter<Order>>;
   friend Base;
   using Base::N;
   using Base::x_;
@@ -69,9 +70,20 @@ class ExtendedKalmanFilter final
   bool zenith_reported_ = false;
 };
 
-std::unique_ptr<Component> create(const Params& p) {
+cartesian_filter::Settings settings(const Params& p) {
   cartesian_filter::Settings s = cartesian_filter::parse_settings(p, "filter.ekf");
   s.zenith = p.choice<cartesian_filter::Settings::Zenith>("zenith");
+  return s;
+}
+
+std::unique_ptr<Component> create(const Params& p) {
+  const cartesian_filter::Settings s = settings(p);
+  if (s.order() == 2) return make_single_track_filter(s.type, s.node, ExtendedKalmanFilter<2>(s));
+  return make_single_track_filter(s.type, s.node, ExtendedKalmanFilter<3>(s));
+}
+
+std::unique_ptr<Estimator> create_estimator(const Params& p) {
+  const cartesian_filter::Settings s = settings(p);
   if (s.order() == 2) return std::make_unique<ExtendedKalmanFilter<2>>(s);
   return std::make_unique<ExtendedKalmanFilter<3>>(s);
 }
@@ -96,12 +108,13 @@ void register_components(Registrar& r) {
   d.accepts = mask(ItemKind::Measurement);
   // Several radars into one track: one input per sensor (docs/filters.md, "Several sensors").
   d.min_inputs = 1;
-  d.max_inputs = FrontEndRunResult::kMaxPorts;
+  d.max_inputs = SingleTrackRunResult::kMaxPorts;
   d.produces = mask(ItemKind::Estimate);
   d.accepts_frames = mask(Frame::Spherical);
   d.params = cartesian_filter::param_specs();
   d.params.push_back(cartesian_filter::zenith_param());
   d.create = create;
+  d.create_estimator = create_estimator;
   r.add(std::move(d));
 }
 

@@ -2,7 +2,7 @@
 #include "spherical_ca_model.hpp"
 #include "spherical_two_point.hpp"
 
-#include <trackflow/filter_front_end.hpp>
+#include <trackflow/single_track_filter.hpp>
 #include <trackflow/geometry.hpp>
 #include <trackflow/kalman.hpp>
 #include <trackflow/motion.hpp>
@@ -36,16 +36,13 @@ constexpr double kNearZenith = 80.0 * std::numbers::pi / 180.0;
 
 // The state is relative to one stationary sensor, in that sensor's azimuth convention: both are
 // fixed by the first measurement of a run.
-class SphericalEkf final : public FilterFrontEnd<SphericalEkf> {
-  friend FilterFrontEnd<SphericalEkf>;
+class SphericalEkf final : public Estimator {
 
  public:
   explicit SphericalEkf(SphericalEkfSettings s)
-      : FilterFrontEnd(FrontEndSpec{"filter.ekf_spherical", s.node, Frame::Spherical, s.range_rate, {"azimuth_dropped"}}),
+      : Estimator(MeasurementSpec{Frame::Spherical, s.range_rate, {"azimuth_dropped"}}),
         s_(std::move(s)) {
     for (int i = 0; i < 3; ++i) q_[i] = s_.q[i];
-    est_.state = State::Zero();
-    est_.covariance = Matrix::Zero();
   }
 
   NoiseHandles noise() override {
@@ -55,7 +52,7 @@ class SphericalEkf final : public FilterFrontEnd<SphericalEkf> {
     return h;
   }
 
-  StateLayout state_layout() const override {
+  StateLayout layout() const override {
     static constexpr StateComponent kLayout[] = {{"R", "m"},     {"v_r", "m/s"}, {"vdot_r", "m/s2"},
                                                  {"theta", "rad"}, {"v_h", "m/s"}, {"vdot_h", "m/s2"},
                                                  {"phi", "rad"},   {"v_v", "m/s"}, {"vdot_v", "m/s2"}};
@@ -65,7 +62,7 @@ class SphericalEkf final : public FilterFrontEnd<SphericalEkf> {
  private:
   enum Counter { kAzimuthDropped };
 
-  bool reset_track() {
+  bool reset() override {
     points_ = 0;
     has_sensor_ = false;
     last_T_ = -1.0;
@@ -80,7 +77,7 @@ class SphericalEkf final : public FilterFrontEnd<SphericalEkf> {
     return !s_.two_point;
   }
 
-  void on_end_run() {
+  void end_run(bool initialised) override {
     if (guard_steps_ > 0)
       warn("propagation guard (R < min_range or |elevation| > max_elevation) held the model's coefficients on " +
            std::to_string(guard_steps_) + " of " + std::to_string(predictions_) + " predictions, first at t=" +
@@ -88,9 +85,9 @@ class SphericalEkf final : public FilterFrontEnd<SphericalEkf> {
            " times; the spherical model is singular there (filter.ekf suits overhead passes)");
   }
 
-  void scale_state_covariance(double k) { P_ *= k; }
+  void scale_covariance(double k) override { P_ *= k; }
 
-  void check_measurement(const Measurement& m) { check_sensor(m); }
+  void check(const Measurement& m) override { check_sensor(m); }
 
   // A spherical state means nothing once the origin or the azimuth reference changes.
   void check_sensor(const Measurement& m) {
@@ -109,7 +106,7 @@ class SphericalEkf final : public FilterFrontEnd<SphericalEkf> {
                       "one stationary sensor (use filter.ekf to fuse sensors)");
   }
 
-  void predict(double T) {
+  void predict(double T) override {
     if (!same_interval(T, last_T_)) {  // fixed-rate data: the unit-intensity Q1 is computed once
       unit_Q1_ = ConstantAcceleration::axis_noise_continuous(T, 1.0);
       last_T_ = T;
@@ -165,8 +162,16 @@ class SphericalEkf final : public FilterFrontEnd<SphericalEkf> {
   }
 
   // Linear measurement (eq 3.61-3.63) in SDK order [r, az, el(, rdot)].
+  bool update(const Measurement& m, int dim) override {
+    return dim == 4 ? update_values<4>(m) : update_values<3>(m);
+  }
+  bool predict_measurement(const SensorFrame& s, const MeasCov& R, PredictedMeasurement& p) const override {
+    return predicted_by_update<SphericalEkf>(s, R, p);
+  }
+  std::unique_ptr<Estimator> clone() const override { return std::make_unique<SphericalEkf>(*this); }
+
   template <int M>
-  bool update(const Measurement& m) {
+  bool update_values(const Measurement& m) {
     using MatM = Eigen::Matrix<double, M, M>;
     Eigen::Matrix<double, M, kDim> H = Eigen::Matrix<double, M, kDim>::Zero();
     H(0, kR) = 1.0;
@@ -252,7 +257,7 @@ class SphericalEkf final : public FilterFrontEnd<SphericalEkf> {
   }
 
   // Two-point differencing in (r, θ, φ): spherical_two_point.hpp.
-  bool initialise(const Measurement& m, int dim) {
+  bool initiate(const Measurement& m, int dim) override {
     Meas4 z = Meas4::Zero();
     Cov4 R = Cov4::Zero();
     z.head(dim) = m.value.head(dim);
@@ -270,7 +275,7 @@ class SphericalEkf final : public FilterFrontEnd<SphericalEkf> {
   }
 
   // ENU block for metrics: p = sensor + R e_r, v = v_r e_r + v_h e_θ + v_v e_φ, cov J P J'.
-  void fill_estimate(Estimate& e) {
+  void fill(Estimate& e) const override {
     e.state.resize(kDim);
     e.state.head<kDim>() = x_;
     e.covariance.resize(kDim, kDim);
@@ -287,8 +292,9 @@ class SphericalEkf final : public FilterFrontEnd<SphericalEkf> {
   State x_ = State::Zero();
   Matrix P_ = Matrix::Identity(), F_ = Matrix::Identity(), Q_ = Matrix::Zero(), FP_ = Matrix::Zero();
   Eigen::Matrix3d unit_Q1_ = Eigen::Matrix3d::Zero();
-  EnuJacobian J_enu_ = EnuJacobian::Zero();
-  Eigen::Matrix<double, 6, kDim> JP_ = Eigen::Matrix<double, 6, kDim>::Zero();
+  // fill's scratch (fill is const: products, no state)
+  mutable EnuJacobian J_enu_ = EnuJacobian::Zero();
+  mutable Eigen::Matrix<double, 6, kDim> JP_ = Eigen::Matrix<double, 6, kDim>::Zero();
   double last_T_ = -1.0;
   bool has_sensor_ = false, zenith_reported_ = false;
   Vec3 sensor_ = Vec3::Zero();
@@ -301,7 +307,8 @@ class SphericalEkf final : public FilterFrontEnd<SphericalEkf> {
   double first_guard_time_ = 0.0;
 };
 
-std::unique_ptr<Component> create(const Params& p) {
+// The estimator of one track from the node's parameters (the node and a tracker take it alike).
+SphericalEkf make_estimator(const Params& p) {
   using S = SphericalEkfSettings;
   S s;
   s.node = p.node();
@@ -334,8 +341,14 @@ std::unique_ptr<Component> create(const Params& p) {
     if (s.x0(kR) <= s.guard.min_range) throw p.error("initial_range", "must exceed min_range");
   }
   s.sigma_accel = p.real("initial_sigma_acceleration");
-  return std::make_unique<SphericalEkf>(s);
+  return SphericalEkf(s);
 }
+
+std::unique_ptr<Component> create(const Params& p) {
+  return make_single_track_filter("filter.ekf_spherical", p.node(), make_estimator(p));
+}
+
+std::unique_ptr<Estimator> create_estimator(const Params& p) { return std::make_unique<SphericalEkf>(make_estimator(p)); }
 
 void register_components(Registrar& r) {
   ComponentDecl d;
@@ -393,6 +406,7 @@ void register_components(Registrar& r) {
           .positive(),
   };
   d.create = create;
+  d.create_estimator = create_estimator;
   r.add(std::move(d));
 }
 

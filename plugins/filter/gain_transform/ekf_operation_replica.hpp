@@ -13,7 +13,7 @@ namespace trackflow::gain_transform::replica {
 template <class S, int R, int C>
 using Mat = Eigen::Matrix<S, R, C>;
 
-// filter.ekf's prediction (plugins/lib/estimation/cartesian_radar_filter.hpp, predict(); the update is
+// filter.ekf's prediction (plugins/lib/estimation/cartesian_radar_estimator.hpp, predict(); the update is
 // ekf_filter.cpp's): x_a = A x_a per axis (27 multiplications),
 // P_ab = A P_ab A' for all nine axis blocks (9 x 54), noise q_a^2 Q1 on the diagonal blocks
 // (3 x 10), then P = (P + P')/2 (81): 597 for the covariance.

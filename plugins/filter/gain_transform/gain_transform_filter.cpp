@@ -1,7 +1,7 @@
 // Purpose: filter.gain_transform — paper 002's gain-transformation filter: Cartesian Singer state, polar [r, az, el] measurements, gains of three decoupled LOS-frame filters rotated to ENU.
 #include "gain_transform_core.hpp"
 
-#include <trackflow/filter_front_end.hpp>
+#include <trackflow/single_track_filter.hpp>
 #include <trackflow/geometry.hpp>
 #include <trackflow/motion.hpp>
 #include <trackflow/plugin.hpp>
@@ -30,16 +30,13 @@ struct GainTransformSettings {
 constexpr double kZenithSigmas = 3.0;
 
 // The measurement front end is the SDK's (filter_front_end.hpp); this class is the model.
-class GainTransformFilter final : public FilterFrontEnd<GainTransformFilter> {
-  friend FilterFrontEnd<GainTransformFilter>;
+class GainTransformEstimator final : public Estimator {
 
  public:
-  explicit GainTransformFilter(GainTransformSettings s)
-      : FilterFrontEnd(FrontEndSpec{"filter.gain_transform", s.node, Frame::Spherical, RangeRateUse::Ignore, {"azimuth_dropped"}}),
+  explicit GainTransformEstimator(GainTransformSettings s)
+      : Estimator(MeasurementSpec{Frame::Spherical, RangeRateUse::Ignore, {"azimuth_dropped"}}),
         s_(std::move(s)) {
     for (double& q : q_) q = s_.sigma;
-    est_.state.resize(9);
-    est_.covariance.resize(9, 9);
   }
 
   NoiseHandles noise() override {
@@ -49,12 +46,12 @@ class GainTransformFilter final : public FilterFrontEnd<GainTransformFilter> {
     return h;
   }
 
-  StateLayout state_layout() const override { return ConstantAcceleration::state_layout(); }
+  StateLayout layout() const override { return ConstantAcceleration::state_layout(); }
 
  private:
   enum Counter { kAzimuthDropped };
 
-  bool reset_track() {
+  bool reset() override {
     points_ = 0;
     last_T_ = -1.0;
     has_frame_ = false;
@@ -62,7 +59,7 @@ class GainTransformFilter final : public FilterFrontEnd<GainTransformFilter> {
     return false;
   }
 
-  void predict(double T) {
+  void predict(double T) override {
     if (!same_interval(T, last_T_)) {  // fixed-rate data: F and the unit-sigma Q are computed once
       const Eigen::Matrix3d F = SingerModel::axis_transition(s_.alpha, T);
       const Eigen::Matrix3d Q = (2.0 * s_.alpha) * SingerModel::noise_per_psd(s_.alpha, T);
@@ -84,7 +81,7 @@ class GainTransformFilter final : public FilterFrontEnd<GainTransformFilter> {
     for (int i = 0; i < 3; ++i) predict_axis(B_[i], model_, s2[i]);
   }
 
-  void scale_state_covariance(double k) {
+  void scale_covariance(double k) override {
     for (auto& B : B_) B = {k * B.pp, k * B.pv, k * B.pa, k * B.vv, k * B.va, k * B.aa};
   }
 
@@ -110,8 +107,16 @@ class GainTransformFilter final : public FilterFrontEnd<GainTransformFilter> {
     return true;
   }
 
+  bool update(const Measurement& m, int dim) override {
+    return dim == 4 ? update_values<4>(m) : update_values<3>(m);
+  }
+  bool predict_measurement(const SensorFrame& s, const MeasCov& R, PredictedMeasurement& p) const override {
+    return predicted_by_update<GainTransformEstimator>(s, R, p);
+  }
+  std::unique_ptr<Estimator> clone() const override { return std::make_unique<GainTransformEstimator>(*this); }
+
   template <int M>
-  bool update(const Measurement& m) {
+  bool update_values(const Measurement& m) {
     const Vec3 d = Vec3(x_[state_index(0, 0)], x_[state_index(1, 0)], x_[state_index(2, 0)]) - m.sensor_position;
     if (!(d.norm() >= kMinRange)) {
       warn("predicted position at the sensor at t=" + std::to_string(m.time) +
@@ -161,7 +166,7 @@ class GainTransformFilter final : public FilterFrontEnd<GainTransformFilter> {
   // lines swapped), acceleration 0 with variance initial_sigma_acceleration^2. The covariance is
   // two-point differencing (Bar-Shalom, Li & Kirubarajan 2001 §5.5.3) per LOS axis of the
   // second point's frame, where its converted covariance is diagonal.
-  bool initialise(const Measurement& m, int) {
+  bool initiate(const Measurement& m, int) override {
     if (points_ > 0 && m.time == tc_[points_ - 1]) --points_;  // same time stamp: keep the newer one
     const double r = m.value(0), az = m.value(1), el = m.value(2);
     const Mat3 J = spherical_to_enu_jacobian(r, az, el, m.azimuth);
@@ -191,7 +196,7 @@ class GainTransformFilter final : public FilterFrontEnd<GainTransformFilter> {
 
   // The published covariance is blkdiag(D) P̄ blkdiag(D)' (enu_covariance()): the ENU covariance
   // the decoupled blocks stand for, in motion.hpp's layout like filter.ekf's Singer state.
-  void fill_estimate(Estimate& e) const {
+  void fill(Estimate& e) const override {
     e.state.resize(9);
     for (int i = 0; i < 9; ++i) e.state(i) = x_[i];
     // Formed in place: a 9x9 Estimate::covariance is 81 contiguous doubles, column-major, as a
@@ -223,15 +228,22 @@ class GainTransformFilter final : public FilterFrontEnd<GainTransformFilter> {
   double tc_[2] = {};
 };
 
-std::unique_ptr<Component> create(const Params& p) {
+// The estimator of one track from the node's parameters (the node and a tracker take it alike).
+GainTransformEstimator make_estimator(const Params& p) {
   GainTransformSettings s;
   s.node = p.node();
   s.alpha = p.real("singer_alpha");
   s.sigma = p.real("singer_sigma");
   s.sigma_accel0 = p.real_or("initial_sigma_acceleration", s.sigma);
   s.reproject = p.choice<FrameChange>("frame_change") == FrameChange::Reproject;
-  return std::make_unique<GainTransformFilter>(s);
+  return GainTransformEstimator(s);
 }
+
+std::unique_ptr<Component> create(const Params& p) {
+  return make_single_track_filter("filter.gain_transform", p.node(), make_estimator(p));
+}
+
+std::unique_ptr<Estimator> create_estimator(const Params& p) { return std::make_unique<GainTransformEstimator>(make_estimator(p)); }
 
 void register_components(Registrar& r) {
   ComponentDecl d;
@@ -271,6 +283,7 @@ void register_components(Registrar& r) {
           .def("reproject"),
   };
   d.create = create;
+  d.create_estimator = create_estimator;
   r.add(std::move(d));
 }
 

@@ -4,7 +4,7 @@
 #include "imm_mixing.hpp"
 
 #include <trackflow/common_params.hpp>
-#include <trackflow/filter_front_end.hpp>
+#include <trackflow/single_track_filter.hpp>
 #include <trackflow/plugin.hpp>
 
 #include <array>
@@ -58,12 +58,11 @@ struct ImmConfig {
 // Blom & Bar-Shalom (1988) IMM, one cycle per measurement: mixing (predict), mode-matched EKF
 // updates, mode probabilities from the innovation likelihoods, and the combined estimate
 // (fill_estimate). The equations and the treatment of unequal state sizes: docs/filters.md.
-class ImmFilter final : public FilterFrontEnd<ImmFilter> {
-  friend FilterFrontEnd<ImmFilter>;
+class ImmEstimator final : public Estimator {
 
  public:
-  explicit ImmFilter(const ImmConfig& c)
-      : FilterFrontEnd(FrontEndSpec{"filter.imm", c.node, Frame::Spherical, c.range_rate,
+  explicit ImmEstimator(const ImmConfig& c)
+      : Estimator(MeasurementSpec{Frame::Spherical, c.range_rate,
                                     {"azimuth_dropped", "mode_updates_refused"}, true}),
         count_(static_cast<int>(c.modes.size())) {
     for (int j = 0; j < count_; ++j) {
@@ -73,9 +72,6 @@ class ImmFilter final : public FilterFrontEnd<ImmFilter> {
       all_acceleration_ = all_acceleration_ && modes_[j].order == 3;
       for (int i = 0; i < count_; ++i) pi_[j * count_ + i] = c.transition[static_cast<size_t>(j * count_ + i)];
     }
-    const int n = any_acceleration_ ? 9 : 6;
-    est_.state.resize(n);
-    est_.covariance.resize(n, n);
   }
 
   NoiseHandles noise() override {
@@ -83,7 +79,7 @@ class ImmFilter final : public FilterFrontEnd<ImmFilter> {
     h.measurement = {&R_, MeasurementSpace::Spherical};
     return h;
   }
-  StateLayout state_layout() const override {
+  StateLayout layout() const override {
     return any_acceleration_ ? ConstantAcceleration::state_layout() : ConstantVelocity::state_layout();
   }
   std::vector<std::string> annotation_names() const override {
@@ -95,7 +91,7 @@ class ImmFilter final : public FilterFrontEnd<ImmFilter> {
  private:
   enum Counter { kAzimuthDropped, kModeRefused };
 
-  bool reset_track() {
+  bool reset() override {
     bool initialised = false;
     for (int j = 0; j < count_; ++j) visit(modes_[j], [&](auto& s) { initialised = s.reset_state(); });
     std::copy(mu0_, mu0_ + count_, mu_);
@@ -105,7 +101,7 @@ class ImmFilter final : public FilterFrontEnd<ImmFilter> {
   }
 
   // Every mode starts from the same two converted points (init: two_point).
-  bool initialise(const Measurement& m, int) {
+  bool initiate(const Measurement& m, int) override {
     bool formed = false;
     for (int j = 0; j < count_; ++j) visit(modes_[j], [&](auto& s) { formed = s.add_point(m, R_); });
     publish_probabilities();
@@ -114,7 +110,7 @@ class ImmFilter final : public FilterFrontEnd<ImmFilter> {
 
   // Interaction (mixing) on the common state, then each mode's own exact prediction. All mixed
   // starts are formed before any mode is overwritten.
-  void predict(double T) {
+  void predict(double T) override {
     imm::mixing_weights(pi_, mu_, count_, c_, w_);
     const imm::ModeView& v = view();
     for (int j = 0; j < count_; ++j) {
@@ -147,8 +143,16 @@ class ImmFilter final : public FilterFrontEnd<ImmFilter> {
     return view_;
   }
 
+  bool update(const Measurement& m, int dim) override {
+    return dim == 4 ? update_values<4>(m) : update_values<3>(m);
+  }
+  bool predict_measurement(const SensorFrame& s, const MeasCov& R, PredictedMeasurement& p) const override {
+    return predicted_by_update<ImmEstimator>(s, R, p);
+  }
+  std::unique_ptr<Estimator> clone() const override { return std::make_unique<ImmEstimator>(*this); }
+
   template <int M>
-  bool update(const Measurement& m) {
+  bool update_values(const Measurement& m) {
     if (!mixed_) std::copy(mu_, mu_ + count_, c_);  // no time elapsed: no transition
     mixed_ = false;
     const Eigen::Matrix<double, M, M> R = R_.template topLeftCorner<M, M>();
@@ -212,12 +216,12 @@ class ImmFilter final : public FilterFrontEnd<ImmFilter> {
   }
 
   void publish_probabilities() {
-    for (int j = 0; j < count_; ++j) annotate_own(j, mu_[j]);
+    for (int j = 0; j < count_; ++j) annotate(j, mu_[j]);
   }
 
   // The combined estimate, moment-matched on the common state. The acceleration of a mode
   // without one is the probability-weighted acceleration of the modes that carry it.
-  void fill_estimate(Estimate& e) const {
+  void fill(Estimate& e) const override {
     const imm::ModeView& v = view();
     // Every mode mixed into the reference has its own acceleration, so the reference passed to
     // that mixture is never read.
@@ -264,7 +268,7 @@ class ImmFilter final : public FilterFrontEnd<ImmFilter> {
     }
   }
 
-  void scale_state_covariance(double k) {
+  void scale_covariance(double k) override {
     for (int j = 0; j < count_; ++j) visit(modes_[j], [&](auto& s) { s.P_ *= k; });
   }
 
@@ -314,7 +318,8 @@ const char* default_name(Settings::Motion m) {
   return "mode";
 }
 
-std::unique_ptr<Component> create(const Params& p) {
+// The estimator of one track from the node's parameters (the node and a tracker take it alike).
+ImmEstimator make_estimator(const Params& p) {
   ImmConfig c;
   c.node = p.node();
   c.range_rate = p.choice<RangeRateUse>("range_rate");
@@ -363,8 +368,14 @@ std::unique_ptr<Component> create(const Params& p) {
   } else {
     c.initial.assign(static_cast<size_t>(n), 1.0 / n);
   }
-  return std::make_unique<ImmFilter>(c);
+  return ImmEstimator(c);
 }
+
+std::unique_ptr<Component> create(const Params& p) {
+  return make_single_track_filter("filter.imm", p.node(), make_estimator(p));
+}
+
+std::unique_ptr<Estimator> create_estimator(const Params& p) { return std::make_unique<ImmEstimator>(make_estimator(p)); }
 
 void register_components(Registrar& r) {
   ComponentDecl d;
@@ -397,6 +408,7 @@ void register_components(Registrar& r) {
       cartesian_filter::zenith_param(),
   };
   d.create = create;
+  d.create_estimator = create_estimator;
   r.add(std::move(d));
 }
 

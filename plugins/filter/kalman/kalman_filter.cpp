@@ -1,6 +1,6 @@
 // Purpose: filter.kalman — linear Kalman filter on Cartesian position measurements with CV or CA motion.
 #include <trackflow/estimate_state.hpp>
-#include <trackflow/filter_front_end.hpp>
+#include <trackflow/single_track_filter.hpp>
 #include <trackflow/kalman.hpp>
 #include <trackflow/motion.hpp>
 #include <trackflow/plugin.hpp>
@@ -18,35 +18,33 @@ struct KalmanSettings {
   enum class Noise { Continuous, Discrete } noise = Noise::Continuous;
   double q = 1.0;  // continuous: PSD of the highest derivative (CV m2/s3, CA m2/s5); discrete: its std
   bool two_point = true;
+  bool constant_acceleration = false;
   Vec3 p0 = Vec3::Zero(), v0 = Vec3::Zero(), a0 = Vec3::Zero();
   double sp0 = 0, sv0 = 0, sa0 = 0;  // initial standard deviations
-  std::string node;
 };
 
 // State [x vx (ax) y vy (ay) z vz (az)]: Model::kOrder states per axis (motion.hpp). The
-// measurement front end is the SDK's (filter_front_end.hpp); this class is the model.
+// estimator of one track (estimator.hpp); the filter node around it is the SDK's
+// SingleTrackFilter (single_track_filter.hpp).
 template <class Model>
-class KalmanFilter final : public FilterFrontEnd<KalmanFilter<Model>> {
-  using FrontEnd = FilterFrontEnd<KalmanFilter<Model>>;
-  friend FrontEnd;
+class KalmanEstimator final : public Estimator {
   static constexpr int N = Model::kDim;
   using StateN = typename Model::State;
   using MatN = typename Model::Matrix;
 
  public:
-  explicit KalmanFilter(KalmanSettings s)
-      : FrontEnd(FrontEndSpec{"filter.kalman", s.node, Frame::Cartesian, RangeRateUse::Ignore, {}}), s_(std::move(s)) {
+  explicit KalmanEstimator(KalmanSettings s)
+      : Estimator(MeasurementSpec{Frame::Cartesian, RangeRateUse::Ignore, {}}), s_(std::move(s)) {
     for (int a = 0; a < 3; ++a) {
       idx_[a] = Model::position_index(a);
       idx_[a + 3] = Model::velocity_index(a);
     }
-    this->est_.state = StateN::Zero();
-    this->est_.covariance = MatN::Zero();
   }
+  std::unique_ptr<Estimator> clone() const override { return std::make_unique<KalmanEstimator>(*this); }
 
   NoiseHandles noise() override {
     NoiseHandles h;
-    h.measurement = {&this->R_, MeasurementSpace::CartesianPosition};
+    h.measurement = {&R_, MeasurementSpace::CartesianPosition};
     h.process.values = &s_.q;
     h.process.count = 1;
     h.process.axes = NoiseAxes::Common;
@@ -60,10 +58,9 @@ class KalmanFilter final : public FilterFrontEnd<KalmanFilter<Model>> {
     return h;
   }
 
-  StateLayout state_layout() const override { return Model::state_layout(); }
+  StateLayout layout() const override { return Model::state_layout(); }
 
- private:
-  bool reset_track() {
+  bool reset() override {
     has_first_ = false;
     independent_axes_ = true;  // explicit: P diagonal; two-point: set by initialise
     if (s_.two_point) return false;
@@ -82,8 +79,8 @@ class KalmanFilter final : public FilterFrontEnd<KalmanFilter<Model>> {
     return true;  // the explicit state holds at the first measurement's time
   }
 
-  void predict(double T) {
-    if (!this->same_interval(T, last_T_)) {  // fixed-rate data: the unit-intensity Q is computed once per T
+  void predict(double T) override {
+    if (!same_interval(T, last_T_)) {  // fixed-rate data: the unit-intensity Q is computed once per T
       unit_Q_ = s_.noise == KalmanSettings::Noise::Continuous ? Model::axis_noise_continuous(T, 1.0)
                                                                : Model::axis_noise_discrete(T, 1.0);
       last_T_ = T;
@@ -100,14 +97,65 @@ class KalmanFilter final : public FilterFrontEnd<KalmanFilter<Model>> {
   // the Joseph-form update from them (kalman.hpp, joseph_update_cross) needs no H and no 6x6x6
   // products. When R is diagonal and P has no cross-axis terms (independent_axes_), the three
   // axes are three independent filters on scalar measurements: the same update, per axis.
-  template <int M>
-  bool update(const Measurement& m) {
-    return update_position(m);  // the front end's range_rate: ignore makes M = 3; one body
+  bool update(const Measurement& m, int) override {
+    return update_position(m);  // range_rate: ignore makes every measurement 3 positions
   }
+
+  // z^ = H x (the three positions), S = H P H' + R: three rows and columns of P.
+  bool predict_measurement(const SensorFrame&, const MeasCov& R, PredictedMeasurement& p) const override {
+    if (R.rows() != 3 || R.cols() != 3) return false;
+    p.z.resize(3);
+    p.S.resize(3, 3);
+    for (int a = 0; a < 3; ++a) {
+      p.z(a) = x_(Model::position_index(a));
+      for (int b = 0; b < 3; ++b) p.S(a, b) = P_(Model::position_index(a), Model::position_index(b)) + R(a, b);
+    }
+    return set_log_det(p);
+  }
+
+  void scale_covariance(double k) override { P_ *= k; }
+
+  // Two-point differencing (Bar-Shalom, Li & Kirubarajan 2001, §5.5.3): position from the
+  // second point, velocity from the difference; covariance from the two R's. A second point
+  // with the same time stamp replaces the first.
+  bool initiate(const Measurement& m, int) override {
+    const Vec3 z = m.value.template head<3>();
+    const Mat3 R = R_.topLeftCorner(3, 3);
+    const double T = m.time - t1_;
+    if (!has_first_ || T <= 0.0) {
+      z1_ = z;
+      R1_ = R;
+      t1_ = m.time;
+      has_first_ = true;
+      return false;
+    }
+    x_.setZero();
+    P_.setZero();
+    for (int a = 0; a < 3; ++a) {
+      const int p = Model::position_index(a), v = Model::velocity_index(a);
+      x_(p) = z(a);
+      x_(v) = (z(a) - z1_(a)) / T;
+      for (int b = 0; b < 3; ++b) {
+        const int pb = Model::position_index(b), vb = Model::velocity_index(b);
+        P_(p, pb) = R(a, b);
+        P_(p, vb) = P_(vb, p) = R(a, b) / T;
+        P_(v, vb) = (R(a, b) + R1_(a, b)) / (T * T);
+      }
+      if constexpr (Model::kOrder == 3) P_(a * 3 + 2, a * 3 + 2) = s_.sa0 * s_.sa0;
+    }
+    P_ = 0.5 * (P_ + P_.transpose()).eval();
+    // Diagonal R at both points: no cross-axis terms in P (exactly zero, not merely small).
+    independent_axes_ = diagonal(R) && diagonal(R1_);
+    return true;
+  }
+
+  void fill(Estimate& e) const override { set_estimate_state(e, x_, P_, idx_); }
+
+ private:
 
   bool update_position(const Measurement& m) {
     const Vec3 z = m.value.template head<3>();
-    const Mat3 R = this->R_.template topLeftCorner<3, 3>();
+    const Mat3 R = R_.template topLeftCorner<3, 3>();
     Vec3 nu;
     for (int a = 0; a < 3; ++a) nu(a) = z(a) - x_(Model::position_index(a));
     Mat3 S;
@@ -124,10 +172,10 @@ class KalmanFilter final : public FilterFrontEnd<KalmanFilter<Model>> {
       ok = joseph_update_cross<N, 3>(x_, P_, nu, PHt, S, nis);
     }
     if (ok) {
-      this->template accept_update<3>(nu, S, nis);
+      accept_update<3>(nu, S, nis);
       return true;
     }
-    this->warn("innovation covariance not positive definite at t=" + std::to_string(m.time) +
+    warn("innovation covariance not positive definite at t=" + std::to_string(m.time) +
                " s; measurement not used");
     return false;
   }
@@ -161,43 +209,6 @@ class KalmanFilter final : public FilterFrontEnd<KalmanFilter<Model>> {
     return true;
   }
 
-  void scale_state_covariance(double k) { P_ *= k; }
-
-  // Two-point differencing (Bar-Shalom, Li & Kirubarajan 2001, §5.5.3): position from the
-  // second point, velocity from the difference; covariance from the two R's. A second point
-  // with the same time stamp replaces the first.
-  bool initialise(const Measurement& m, int) {
-    const Vec3 z = m.value.template head<3>();
-    const Mat3 R = this->R_.topLeftCorner(3, 3);
-    const double T = m.time - t1_;
-    if (!has_first_ || T <= 0.0) {
-      z1_ = z;
-      R1_ = R;
-      t1_ = m.time;
-      has_first_ = true;
-      return false;
-    }
-    x_.setZero();
-    P_.setZero();
-    for (int a = 0; a < 3; ++a) {
-      const int p = Model::position_index(a), v = Model::velocity_index(a);
-      x_(p) = z(a);
-      x_(v) = (z(a) - z1_(a)) / T;
-      for (int b = 0; b < 3; ++b) {
-        const int pb = Model::position_index(b), vb = Model::velocity_index(b);
-        P_(p, pb) = R(a, b);
-        P_(p, vb) = P_(vb, p) = R(a, b) / T;
-        P_(v, vb) = (R(a, b) + R1_(a, b)) / (T * T);
-      }
-      if constexpr (Model::kOrder == 3) P_(a * 3 + 2, a * 3 + 2) = s_.sa0 * s_.sa0;
-    }
-    P_ = 0.5 * (P_ + P_.transpose()).eval();
-    // Diagonal R at both points: no cross-axis terms in P (exactly zero, not merely small).
-    independent_axes_ = diagonal(R) && diagonal(R1_);
-    return true;
-  }
-
-  void fill_estimate(Estimate& e) const { set_estimate_state(e, x_, P_, idx_); }
 
   KalmanSettings s_;
   StateN x_ = StateN::Zero();
@@ -213,9 +224,8 @@ class KalmanFilter final : public FilterFrontEnd<KalmanFilter<Model>> {
   int idx_[6] = {};
 };
 
-std::unique_ptr<Component> create(const Params& p) {
+KalmanSettings parse_settings(const Params& p) {
   KalmanSettings s;
-  s.node = p.node();
   const bool ca = p.choice<Motion>("motion") == Motion::ConstantAcceleration;
   if (p.given("sigma_accel") && (p.given("q") || p.given("q_jerk")))
     throw p.error("sigma_accel", "give either a continuous-noise intensity (q / q_jerk) or sigma_accel, not both");
@@ -238,8 +248,23 @@ std::unique_ptr<Component> create(const Params& p) {
   s.sp0 = p.real_or("initial_sigma_position", 0.0);
   s.sv0 = p.real_or("initial_sigma_velocity", 0.0);
   s.sa0 = p.real("initial_sigma_acceleration");
-  if (ca) return std::make_unique<KalmanFilter<ConstantAcceleration>>(s);
-  return std::make_unique<KalmanFilter<ConstantVelocity>>(s);
+  s.constant_acceleration = ca;
+  return s;
+}
+
+std::unique_ptr<Component> create(const Params& p) {
+  const KalmanSettings s = parse_settings(p);
+  if (s.constant_acceleration)
+    return std::make_unique<SingleTrackFilter<KalmanEstimator<ConstantAcceleration>>>(
+        "filter.kalman", p.node(), KalmanEstimator<ConstantAcceleration>(s));
+  return std::make_unique<SingleTrackFilter<KalmanEstimator<ConstantVelocity>>>(
+      "filter.kalman", p.node(), KalmanEstimator<ConstantVelocity>(s));
+}
+
+std::unique_ptr<Estimator> create_estimator(const Params& p) {
+  const KalmanSettings s = parse_settings(p);
+  if (s.constant_acceleration) return std::make_unique<KalmanEstimator<ConstantAcceleration>>(s);
+  return std::make_unique<KalmanEstimator<ConstantVelocity>>(s);
 }
 
 void register_components(Registrar& r) {
@@ -281,6 +306,7 @@ void register_components(Registrar& r) {
           .positive(),
   };
   d.create = create;
+  d.create_estimator = create_estimator;
   r.add(std::move(d));
 }
 

@@ -2,7 +2,7 @@
 #include "lpf_noise.hpp"
 #include "refraction_ekf_model.hpp"
 
-#include <trackflow/filter_front_end.hpp>
+#include <trackflow/single_track_filter.hpp>
 #include <trackflow/geometry.hpp>
 #include <trackflow/plugin.hpp>
 
@@ -42,20 +42,17 @@ struct Settings {
   double convergence_window = 20.0, convergence_ratio = 10.0;
 };
 
-class RefractionEkf final : public FilterFrontEnd<RefractionEkf> {
-  friend FilterFrontEnd<RefractionEkf>;
+class RefractionEkf final : public Estimator {
 
  public:
   enum Counter { kConverged, kNotConverged, kNonFinite, kNormalised };
 
   explicit RefractionEkf(Settings s)
-      : FilterFrontEnd(FrontEndSpec{"filter.refraction_ekf", s.node, Frame::Spherical, RangeRateUse::Ignore,
+      : Estimator(MeasurementSpec{Frame::Spherical, RangeRateUse::Ignore,
                                     {"converged_runs", "not_converged_runs", "non_finite_steps", "gain_normalised"}}),
         s_(std::move(s)) {
     for (int i = 0; i < kN; ++i) scale_(i) = i < 9 ? s_.scale : 1.0;
     q_[0] = q_[1] = q_[2] = s_.sigma_accel;
-    est_.state.resize(kN);
-    est_.covariance.resize(kN, kN);
   }
 
   NoiseHandles noise() override {
@@ -69,10 +66,9 @@ class RefractionEkf final : public FilterFrontEnd<RefractionEkf> {
     h.process.axes = NoiseAxes::Enu;
     return h;
   }
-  StateLayout state_layout() const override { return {rx::kLayout, kN}; }
+  StateLayout layout() const override { return {rx::kLayout, kN}; }
 
-  void finish(Summary& s, const FinishContext& ctx) override {
-    FilterFrontEnd::finish(s, ctx);
+  void finish(Summary& s) const override {
     s.notes.push_back("a run converged when it ended with a finite state and its innovations within " +
                       std::to_string(s_.convergence_ratio) + " measurement sigmas: sqrt of the exponential average "
                       "(time constant " + std::to_string(s_.convergence_window) + " s) of nu' R^-1 nu / 3 (not the "
@@ -83,7 +79,7 @@ class RefractionEkf final : public FilterFrontEnd<RefractionEkf> {
 
  private:
   // --- front-end hooks ---
-  bool reset_track() {
+  bool reset() override {
     points_ = 0;
     finite_ = true;
     ratio_avg_ = -1.0;
@@ -93,7 +89,7 @@ class RefractionEkf final : public FilterFrontEnd<RefractionEkf> {
 
   // Two measurements init_span apart (or more): position from the later one with the bias taken
   // out by Clark at the first elevation, velocity by differencing (previous velocity the same).
-  bool initialise(const Measurement& m, int) {
+  bool initiate(const Measurement& m, int) override {
     lpf_update(m);
     const double step = points_ > 0 ? m.time - collect_time_ : 0.0;  // this measurement's interval
     collect_time_ = m.time;
@@ -169,7 +165,7 @@ class RefractionEkf final : public FilterFrontEnd<RefractionEkf> {
     return true;
   }
 
-  void predict(double T) {
+  void predict(double T) override {
     const State X = unscaled();
     Matrix A;
     State Y = rx::propagate(X, T, s_.model, &A);
@@ -201,8 +197,16 @@ class RefractionEkf final : public FilterFrontEnd<RefractionEkf> {
     last_T_ = T;
   }
 
+  bool update(const Measurement& m, int dim) override {
+    return dim == 4 ? update_values<4>(m) : update_values<3>(m);
+  }
+  bool predict_measurement(const SensorFrame& s, const MeasCov& R, PredictedMeasurement& p) const override {
+    return predicted_by_update<RefractionEkf>(s, R, p);
+  }
+  std::unique_ptr<Estimator> clone() const override { return std::make_unique<RefractionEkf>(*this); }
+
   template <int M>
-  bool update(const Measurement& m) {
+  bool update_values(const Measurement& m) {
     lpf_update(m);
     last_time_ = m.time;
     Eigen::Matrix3d R = R_.topLeftCorner(3, 3);
@@ -264,7 +268,7 @@ class RefractionEkf final : public FilterFrontEnd<RefractionEkf> {
     return true;
   }
 
-  void fill_estimate(Estimate& e) const {
+  void fill(Estimate& e) const override {
     const State X = unscaled();
     const Matrix P = scale_.cwiseInverse().asDiagonal() * Ps_ * scale_.cwiseInverse().asDiagonal();
     e.state = X;
@@ -283,15 +287,15 @@ class RefractionEkf final : public FilterFrontEnd<RefractionEkf> {
     e.enu_covariance = G * P * G.transpose();
   }
 
-  void scale_state_covariance(double k) { Ps_ *= k; }
+  void scale_covariance(double k) override { Ps_ *= k; }
 
-  void check_measurement(const Measurement& m) {
+  void check(const Measurement& m) override {
     sensor_ = m.sensor_position;
   }
 
-  void on_end_run() {
+  void end_run(bool initialised) override {
     const bool converged = finite_ && ratio_avg_ >= 0.0 && std::isfinite(ratio_avg_) &&
-                           std::sqrt(ratio_avg_) < s_.convergence_ratio && initialised();
+                           std::sqrt(ratio_avg_) < s_.convergence_ratio && initialised;
     count(converged ? kConverged : kNotConverged);
   }
 
@@ -331,7 +335,8 @@ class RefractionEkf final : public FilterFrontEnd<RefractionEkf> {
   rx::LowPassNoise lpf_[3];
 };
 
-std::unique_ptr<Component> create(const Params& p) {
+// The estimator of one track from the node's parameters (the node and a tracker take it alike).
+RefractionEkf make_estimator(const Params& p) {
   Settings s;
   s.node = p.node();
   s.model.clark = sim::read_clark(p, false);
@@ -362,8 +367,14 @@ std::unique_ptr<Component> create(const Params& p) {
   s.bias_uncertainty = p.real("initial_bias_uncertainty");
   s.convergence_window = p.real("convergence_window");
   s.convergence_ratio = p.real("convergence_ratio");
-  return std::make_unique<RefractionEkf>(std::move(s));
+  return RefractionEkf(std::move(s));
 }
+
+std::unique_ptr<Component> create(const Params& p) {
+  return make_single_track_filter("filter.refraction_ekf", p.node(), make_estimator(p));
+}
+
+std::unique_ptr<Estimator> create_estimator(const Params& p) { return std::make_unique<RefractionEkf>(make_estimator(p)); }
 
 const char* const kDoc =
     "Paper 004 (Seo et al. 2017): the refraction bias b on elevation estimated as a state. State (13) [x, vx, vx_prev, "
@@ -455,6 +466,7 @@ void register_components(Registrar& r) {
   };
   for (auto& spec : sim::clark_param_specs(false)) d.params.push_back(std::move(spec));
   d.create = create;
+  d.create_estimator = create_estimator;
   r.add(std::move(d));
 }
 

@@ -1,11 +1,12 @@
 // Purpose: filter.ukf — scaled unscented Kalman filter with a Cartesian ENU state (CV, CA or Singer motion) on spherical [r, az, el(, rdot)] measurements.
-#include "estimation/cartesian_radar_filter.hpp"
+#include "estimation/cartesian_radar_estimator.hpp"
 #include "sigma_spherical.hpp"
 #include "unscented_transform.hpp"
 
 #include <trackflow/number_text.hpp>
 #include <trackflow/kalman.hpp>
 #include <trackflow/plugin.hpp>
+#include <trackflow/single_track_filter.hpp>
 #include <trackflow/spherical_measurement.hpp>
 
 #include <Eigen/Cholesky>
@@ -22,13 +23,13 @@ struct UnscentedSettings {
   double alpha = 1.0, beta = 2.0, kappa = 0.0;
 };
 
-// Settings, measurement checks, initialisation, prediction and publishing: cartesian_radar_filter.hpp.
+// Settings, measurement checks, initialisation, prediction and publishing: cartesian_radar_estimator.hpp.
 // The prediction there is the linear F x, F P F' + Q: for a linear map the unscented transform
 // returns exactly these moments, so sigma points are used only for the nonlinear h.
 template <int Order>
 class UnscentedKalmanFilter final
-    : public cartesian_filter::CartesianRadarFilter<Order, UnscentedKalmanFilter<Order>> {
-  using Base = cartesian_filter::CartesianRadarFilter<Order, UnscentedKalmanFilter<Order>>;
+    : public cartesian_filter::CartesianRadarEstimator<Order, UnscentedKalmanFilter<Order>> {
+  using Base = cartesian_filter::CartesianRadarEstimator<Order, UnscentedKalmanFilter<Order>>;
   friend Base;
   using Base::N;
   using Base::x_;
@@ -165,7 +166,8 @@ class UnscentedKalmanFilter final
   double max_jitter_ = 0.0;
 };
 
-std::unique_ptr<Component> create(const Params& p) {
+template <class Make>
+auto make(const Params& p, Make&& make_one) {
   const cartesian_filter::Settings s = cartesian_filter::parse_settings(p, "filter.ukf");
   const int n = s.state_dim();
   UnscentedSettings u;
@@ -176,8 +178,19 @@ std::unique_ptr<Component> create(const Params& p) {
     throw p.error("kappa", "kappa must exceed -n = " + std::to_string(-n) + " (the state has n = " +
                                std::to_string(n) + " elements): the sigma points lie at sqrt(alpha^2 (n + kappa)) "
                                "standard deviations");
-  if (s.order() == 2) return std::make_unique<UnscentedKalmanFilter<2>>(s, u);
-  return std::make_unique<UnscentedKalmanFilter<3>>(s, u);
+  return s.order() == 2 ? make_one(UnscentedKalmanFilter<2>(s, u), s) : make_one(UnscentedKalmanFilter<3>(s, u), s);
+}
+
+std::unique_ptr<Component> create(const Params& p) {
+  return make(p, [](auto e, const cartesian_filter::Settings& s) -> std::unique_ptr<Component> {
+    return make_single_track_filter(s.type, s.node, std::move(e));
+  });
+}
+
+std::unique_ptr<Estimator> create_estimator(const Params& p) {
+  return make(p, [](auto e, const cartesian_filter::Settings&) -> std::unique_ptr<Estimator> {
+    return std::make_unique<decltype(e)>(std::move(e));
+  });
 }
 
 void register_components(Registrar& r) {
@@ -200,7 +213,7 @@ void register_components(Registrar& r) {
   d.accepts = mask(ItemKind::Measurement);
   // Several radars into one track: one input per sensor (docs/filters.md, "Several sensors").
   d.min_inputs = 1;
-  d.max_inputs = FrontEndRunResult::kMaxPorts;
+  d.max_inputs = SingleTrackRunResult::kMaxPorts;
   d.produces = mask(ItemKind::Estimate);
   d.accepts_frames = mask(Frame::Spherical);
   d.params = cartesian_filter::param_specs();
@@ -215,6 +228,7 @@ void register_components(Registrar& r) {
   d.params.push_back(ParamSpec::real("kappa", dim::none,
                                      "secondary scaling; n + kappa > 0 (default 3 - n: -3 for CV, -6 for CA/Singer)"));
   d.create = create;
+  d.create_estimator = create_estimator;
   r.add(std::move(d));
 }
 

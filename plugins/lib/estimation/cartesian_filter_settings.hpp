@@ -1,7 +1,7 @@
 // Purpose: settings of the Cartesian-state radar filters (filter.ekf, filter.ukf; the motion block also filter.imm's modes and filter.track_fusion) — motion and noise model, range-rate use, initialisation — with their parameter declarations and parsing.
 #pragma once
 
-#include <trackflow/filter_front_end.hpp>
+#include <trackflow/common_params.hpp>
 #include <trackflow/items.hpp>
 #include <trackflow/params.hpp>
 #include <trackflow/units.hpp>

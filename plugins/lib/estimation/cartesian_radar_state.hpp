@@ -1,4 +1,4 @@
-// Purpose: the state of a Cartesian radar filter without its front end (filter.ekf, filter.ukf, and each mode of filter.imm): settings, initialisation from converted points, the exact linear prediction, Estimate filling.
+// Purpose: the state of a Cartesian radar estimator without its update (filter.ekf, filter.ukf, and each mode of filter.imm): settings, initialisation from converted points, the exact linear prediction, Estimate filling.
 #pragma once
 
 #include "cartesian_filter_settings.hpp"
@@ -19,7 +19,7 @@ namespace trackflow::cartesian_filter {
 // State [x vx (ax) y vy (ay) z vz (az)], Order states per axis (motion.hpp layout), absolute ENU;
 // the sensor is at rest at Measurement::sensor_position. The prediction is linear (F x,
 // F P F' + Q): the motion models are linear in Cartesian coordinates, so any filter on this state
-// predicts exactly this way. CartesianRadarFilter puts it behind the SDK front end; filter.imm
+// predicts exactly this way. CartesianRadarEstimator makes it an SDK estimator; filter.imm
 // holds one per mode.
 template <int Order>
 class CartesianRadarState {
@@ -63,7 +63,7 @@ class CartesianRadarState {
   }
 
   // Predicts T > 0 seconds ahead. `same_model`: T equals last_interval() to the precision of the
-  // time stamps (FilterFrontEnd::same_interval), so F and Q computed for it are used again.
+  // time stamps (Estimator::same_interval), so F and Q computed for it are used again.
   void predict_state(double T, bool same_model) {
     if (!same_model) {  // fixed-rate data: F and the unit-intensity Q are computed once
       compute_axis_model(T);

@@ -1,5 +1,5 @@
-// Purpose: test-only plugins that misbehave the way a buggy plugin can (test.misbehave: throws, crashes, aborts at a chosen item; test.nan_estimates: publishes NaN; test.nan_filter: a front-end filter whose state turns NaN), for tests/hostile.
-#include <trackflow/filter_front_end.hpp>
+// Purpose: test-only plugins that misbehave the way a buggy plugin can (test.misbehave: throws, crashes, aborts at a chosen item; test.nan_estimates: publishes NaN; test.nan_filter: a single-track filter whose estimator's state turns NaN), for tests/hostile.
+#include <trackflow/single_track_filter.hpp>
 #include <trackflow/plugin.hpp>
 
 #include <cmath>
@@ -87,34 +87,34 @@ class NanEstimates final : public Filter {
   long long count_ = 0;
 };
 
-// A filter through the SDK front end whose state becomes NaN at the update at time `at`: the
-// front end must refuse that step instead of publishing it.
-class NanFilter final : public FilterFrontEnd<NanFilter> {
-  friend FilterFrontEnd<NanFilter>;
-
+// An estimator behind the SDK's single-track node whose state becomes NaN at the update at time
+// `at`: the node must refuse that step instead of publishing it.
+class NanEstimator final : public Estimator {
  public:
-  NanFilter(const Params& p)
-      : FilterFrontEnd(FrontEndSpec{"test.nan_filter", p.node(), Frame::Cartesian, RangeRateUse::Ignore, {}}),
-        at_(p.real("at")) {
-    est_.state.resize(6);
-    est_.covariance.resize(6, 6);
-  }
+  explicit NanEstimator(const Params& p)
+      : Estimator(MeasurementSpec{Frame::Cartesian, RangeRateUse::Ignore, {}}), at_(p.real("at")) {}
   NoiseHandles noise() override { return {}; }
+  StateLayout layout() const override {
+    static constexpr StateComponent kLayout[] = {{"x", "m"}, {"y", "m"}, {"z", "m"},
+                                                 {"a", "m"}, {"b", "m"}, {"c", "m"}};
+    return {kLayout, 6};
+  }
+  std::unique_ptr<Estimator> clone() const override { return std::make_unique<NanEstimator>(*this); }
 
  private:
-  bool reset_track() { return false; }
-  bool initialise(const Measurement& m, int) {
+  bool reset() override { return false; }
+  bool initiate(const Measurement& m, int) override {
     x_ = m.value.head<3>();
     return true;
   }
-  void predict(double) {}
-  template <int M>
-  bool update(const Measurement& m) {
+  void predict(double) override {}
+  bool predict_measurement(const SensorFrame&, const MeasCov&, PredictedMeasurement&) const override { return false; }
+  bool update(const Measurement& m, int) override {
     x_ = m.value.head<3>();
     if (std::abs(m.time - at_) < 1e-9) x_(1) = std::numeric_limits<double>::quiet_NaN();
     return true;
   }
-  void fill_estimate(Estimate& e) const {
+  void fill(Estimate& e) const override {
     e.state.setZero();
     e.state.head<3>() = x_;
     e.covariance.setIdentity();
@@ -122,7 +122,7 @@ class NanFilter final : public FilterFrontEnd<NanFilter> {
     e.enu.head<3>() = x_;
     e.enu_covariance.setIdentity();
   }
-  void scale_state_covariance(double) {}
+  void scale_covariance(double) override {}
 
   const double at_;
   Vec3 x_ = Vec3::Zero();
@@ -171,7 +171,9 @@ void register_components(Registrar& r) {
   f.accepts = mask(ItemKind::Measurement);
   f.accepts_frames = mask(Frame::Cartesian);
   f.produces = mask(ItemKind::Estimate);
-  f.create = [](const Params& p) -> std::unique_ptr<Component> { return std::make_unique<NanFilter>(p); };
+  f.create = [](const Params& p) -> std::unique_ptr<Component> {
+    return make_single_track_filter("test.nan_filter", p.node(), NanEstimator(p));
+  };
   r.add(f);
 }
 

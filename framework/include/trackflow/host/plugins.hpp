@@ -57,6 +57,9 @@ class PluginRegistry {
 
   // The component lives as long as the returned pointer; its deleter keeps the library loaded.
   std::shared_ptr<Component> create(const RegisteredType& t, const Params& p) const;
+  // The per-track estimator of a filter type that declares one (ComponentDecl::create_estimator);
+  // it keeps its plugin loaded. A type without one is refused, naming the types that have one.
+  std::shared_ptr<Estimator> create_estimator(const RegisteredType& t, const Params& p) const;
 
  private:
   std::vector<RegisteredType> types_;

@@ -3,6 +3,7 @@
 
 #include <trackflow/component.hpp>
 #include <trackflow/error.hpp>
+#include <trackflow/estimator.hpp>
 #include <trackflow/params.hpp>
 
 #include <cmath>
@@ -31,6 +32,11 @@ class PluginFixture {
   // get their slots as in the engine.
   std::shared_ptr<Component> make(const std::string& type, const std::string& yaml_params = "{}",
                                   const std::string& node_id = "node") const;
+
+  // The per-track estimator of a filter type (ComponentDecl::create_estimator) from those
+  // parameters, as a tracker gets it.
+  std::shared_ptr<Estimator> make_estimator(const std::string& type, const std::string& yaml_params = "{}",
+                                            const std::string& node_id = "node") const;
 
   // The loaded registry, for in-tree tests of the host (its definition is a host header, not installed).
   struct State;

@@ -1,10 +1,10 @@
-// Purpose: the Cartesian-state radar filters' common part (filter.ekf, filter.ukf): the Cartesian radar state (cartesian_radar_state.hpp) on the SDK front end, with its noise handles; the derived filter supplies the update.
+// Purpose: the Cartesian-state radar estimators' common part (filter.ekf, filter.ukf): the Cartesian radar state (cartesian_radar_state.hpp) as an SDK estimator, with its noise handles; the derived estimator supplies the update.
 #pragma once
 
 #include "cartesian_filter_settings.hpp"
 #include "cartesian_radar_state.hpp"
 
-#include <trackflow/filter_front_end.hpp>
+#include <trackflow/estimator.hpp>
 #include <trackflow/error.hpp>
 #include <trackflow/geometry.hpp>
 #include <trackflow/motion.hpp>
@@ -16,19 +16,15 @@
 
 namespace trackflow::cartesian_filter {
 
-// A Cartesian radar state (cartesian_radar_state.hpp) behind the SDK's measurement front end
-// (filter_front_end.hpp).
-// Derived (CRTP) provides
+// A Cartesian radar state (cartesian_radar_state.hpp) as an SDK estimator (estimator.hpp).
+// Derived (CRTP, final) provides
 //   static std::vector<std::string> counter_names();   its counted events (count(i))
 //   void on_start_run();  void on_end_run_report();    its own per-run state and reports
 //   template <int M> bool correct(const Measurement&); M = 3 or 4: correct x_ and P_ with the
 //       measurement's first M values and R_.topLeftCorner(M, M); call accept_update() on success.
 template <int Order, class Derived>
-class CartesianRadarFilter : public FilterFrontEnd<CartesianRadarFilter<Order, Derived>>,
-                             protected CartesianRadarState<Order> {
+class CartesianRadarEstimator : public Estimator, protected CartesianRadarState<Order> {
   using State = CartesianRadarState<Order>;
-  using FrontEnd = FilterFrontEnd<CartesianRadarFilter<Order, Derived>>;
-  friend FrontEnd;
 
  public:
   using typename State::Layout;
@@ -38,7 +34,7 @@ class CartesianRadarFilter : public FilterFrontEnd<CartesianRadarFilter<Order, D
 
   NoiseHandles noise() override {
     NoiseHandles h;
-    h.measurement = {&this->R_, MeasurementSpace::Spherical};
+    h.measurement = {&R_, MeasurementSpace::Spherical};
     h.process.values = this->q_;
     h.process.count = 3;
     h.process.axes = NoiseAxes::Enu;
@@ -59,14 +55,28 @@ class CartesianRadarFilter : public FilterFrontEnd<CartesianRadarFilter<Order, D
     return h;
   }
 
-  StateLayout state_layout() const override { return Layout::state_layout(); }
+  StateLayout layout() const override { return Layout::state_layout(); }
+  std::unique_ptr<Estimator> clone() const override { return std::make_unique<Derived>(derived()); }
+
+  bool reset() override {
+    derived().on_start_run();
+    return this->reset_state();
+  }
+  bool update(const Measurement& m, int dim) override {
+    return dim == 4 ? derived().template correct<4>(m) : derived().template correct<3>(m);
+  }
+  bool predict_measurement(const SensorFrame& s, const MeasCov& R, PredictedMeasurement& p) const override {
+    return predicted_by_update<Derived>(s, R, p);
+  }
+  void scale_covariance(double k) override { P_ *= k; }
+  void end_run(bool) override { derived().on_end_run_report(); }
+  void predict(double T) override { this->predict_state(T, same_interval(T, this->last_interval())); }
+  bool initiate(const Measurement& m, int) override { return this->add_point(m, R_); }
+  void fill(Estimate& e) const override { this->fill_state(e); }
 
  protected:
-  explicit CartesianRadarFilter(Settings s)
-      : FrontEnd(FrontEndSpec{s.type, s.node, Frame::Spherical, s.range_rate, derived_counters(), true}), State(s) {
-    this->est_.state.resize(N);
-    this->est_.covariance.resize(N, N);
-  }
+  explicit CartesianRadarEstimator(Settings s)
+      : Estimator(MeasurementSpec{Frame::Spherical, s.range_rate, Derived::counter_names(), true}), State(s) {}
 
   using State::settings;
   using State::x_;
@@ -75,26 +85,7 @@ class CartesianRadarFilter : public FilterFrontEnd<CartesianRadarFilter<Order, D
 
  private:
   Derived& derived() { return static_cast<Derived&>(*this); }
-  static std::vector<std::string> derived_counters() { return Derived::counter_names(); }
-
-  // Front-end hooks.
-  bool reset_track() {
-    derived().on_start_run();
-    return this->reset_state();
-  }
-
-  template <int M>
-  bool update(const Measurement& m) {
-    return derived().template correct<M>(m);
-  }
-
-  void scale_state_covariance(double k) { P_ *= k; }
-
-  void on_end_run() { derived().on_end_run_report(); }
-
-  void predict(double T) { this->predict_state(T, this->same_interval(T, this->last_interval())); }
-  bool initialise(const Measurement& m, int) { return this->add_point(m, this->R_); }
-  void fill_estimate(Estimate& e) const { this->fill_state(e); }
+  const Derived& derived() const { return static_cast<const Derived&>(*this); }
 };
 
 }  // namespace trackflow::cartesian_filter

@@ -1,0 +1,189 @@
+// Purpose: the per-track estimator contract — initiate from detections, predict, predict the measurement (z, S, log det S) without updating, update, fill an Estimate, name the state, expose the noise, clone — that single-track filter nodes and trackers run.
+#pragma once
+
+#include <trackflow/common_params.hpp>
+#include <trackflow/geometry.hpp>
+#include <trackflow/items.hpp>
+#include <trackflow/noise.hpp>
+
+#include <Eigen/Cholesky>
+#include <Eigen/Core>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <string>
+#include <vector>
+
+namespace trackflow {
+
+struct Summary;
+
+// What an estimator measures with; the host checks each detection against it before the
+// estimator sees one (frame, number of values, range rate, a tilted sensor).
+struct MeasurementSpec {
+  Frame frame = Frame::Spherical;
+  // Spherical estimators: use the range rate when present (Auto), always (Use) or never (Ignore).
+  // Cartesian estimators take the three position values: Ignore.
+  RangeRateUse range_rate = RangeRateUse::Ignore;
+  // Estimator-specific events counted per run and reported in the summary (Estimator::count).
+  std::vector<std::string> counters;
+  // Whether the measurement function turns into the sensor's own axes (SensorFrame::sensor_axes);
+  // otherwise a tilted sensor's detection is refused before the estimator sees it.
+  bool tilted_sensors = false;
+};
+
+// The track an estimator runs for, implemented by whoever runs it (a single-track filter node, a
+// tracker's track): where its warnings, counts and annotations go, the time of the detection being
+// processed, and the estimate that receives an accepted update's innovation.
+class TrackContext {
+ public:
+  virtual void warn(const std::string& message) = 0;
+  virtual void count(int counter) = 0;
+  virtual void annotate(int index, double value) = 0;
+  double time = 0.0;
+  Estimate* estimate = nullptr;
+  std::string who;  // "filter.kalman (node 'kf')", for messages
+
+ protected:
+  ~TrackContext() = default;
+};
+
+// A track's predicted measurement for a sensor: z^, S = H P H' + R and log det S, for gating and
+// likelihoods. An angle in z^ lies in (-pi, pi]; a residual against it is wrapped by whoever forms it.
+struct PredictedMeasurement {
+  MeasVec z;
+  MeasCov S;
+  double log_det_S = 0.0;
+};
+
+// Sets p.log_det_S from p.S by Cholesky; false (and log_det_S = NaN) when S is not positive definite.
+inline bool set_log_det(PredictedMeasurement& p) {
+  const Eigen::LLT<MeasCov> llt(p.S);
+  if (llt.info() != Eigen::Success) {
+    p.log_det_S = std::numeric_limits<double>::quiet_NaN();
+    return false;
+  }
+  p.log_det_S = 2.0 * llt.matrixLLT().diagonal().array().log().sum();
+  return std::isfinite(p.log_det_S);
+}
+
+// One track's state estimator. The host calls reset() at the start of each run (and when the
+// track restarts), initiate() with usable measurements until it returns true, then predict(T)
+// (T > 0 s) and update() per measurement, fill() when the estimate is published. A measurement is
+// one detection with its sensor frame and time (items.hpp); a tracker assembles one per detection
+// it assigns. Measurements reach the estimator valid, finite, in its frame and of the declared
+// dimension `dim` (3, or 4 with range rate); R_ holds the detection's covariance, or what an adapter
+// put there. A concrete estimator should be `final`: the single-track node then calls it without a
+// virtual call.
+class Estimator {
+ public:
+  virtual ~Estimator() = default;
+
+  virtual bool reset() = 0;  // true: initialised at once (explicit initial state)
+  virtual bool initiate(const Measurement& m, int dim) = 0;
+  virtual void predict(double T) = 0;
+  // The predicted measurement from the current (predicted) state for a detection of sensor `s`
+  // with noise R (its size is the measurement dimension); false when there is none (a predicted
+  // position at the sensor). Changes nothing.
+  virtual bool predict_measurement(const SensorFrame& s, const MeasCov& R, PredictedMeasurement& p) const = 0;
+  // On success call accept_update(); false: the measurement is not used (warn() why).
+  virtual bool update(const Measurement& m, int dim) = 0;
+  // State, covariance (layout() order) and the ENU position/velocity block.
+  virtual void fill(Estimate& e) const = 0;
+  virtual void scale_covariance(double k) = 0;  // P <- k P in the estimator's own representation
+  virtual StateLayout layout() const = 0;
+  // The noise adapters may read and overwrite (noise.hpp), this track's own.
+  virtual NoiseHandles noise() = 0;
+  virtual std::unique_ptr<Estimator> clone() const = 0;
+
+  // Optional: further checks of a valid measurement (throw DataError), names of values the
+  // estimator annotates its estimates with (set by annotate()), a report at the end of each run
+  // (`initialised`: whether the track was), notes for the summary.
+  virtual void check(const Measurement&) {}
+  virtual std::vector<std::string> annotation_names() const { return {}; }
+  virtual void end_run(bool /*initialised*/) {}
+  virtual void finish(Summary&) const {}
+
+  const MeasurementSpec& measurement_spec() const { return spec_; }
+  void bind(TrackContext& track) { track_ = &track; }
+  MeasCov& measurement_noise() { return R_; }
+
+ protected:
+  explicit Estimator(MeasurementSpec spec) : spec_(std::move(spec)) { R_ = MeasCov::Zero(3, 3); }
+  Estimator(const Estimator&) = default;
+  Estimator& operator=(const Estimator&) = default;
+
+  void warn(const std::string& message) const {
+    if (track_) track_->warn(message);
+  }
+  void count(int counter) const {
+    if (track_) track_->count(counter);
+  }
+  void annotate(int index, double value) const {
+    if (track_) track_->annotate(index, value);
+  }
+  double time() const { return track_ ? track_->time : 0.0; }
+  std::string who() const { return track_ ? track_->who : std::string("estimator"); }
+  // Whether the interval T to this measurement equals `last_T` to the precision of the time
+  // stamps (4 ulps of the current time), so that a motion model computed for last_T may be used
+  // again. Fixed-rate data are stamped t0 + k / rate, rounded: their intervals differ in the last
+  // bits (by up to ~5e-12 of a 25 ms interval after 540 s), which no model can resolve, and
+  // comparing them exactly would recompute F and Q at nearly every step.
+  bool same_interval(double T, double last_T) const {
+    return std::fabs(T - last_T) <= 4.0 * std::numeric_limits<double>::epsilon() * std::fabs(time());
+  }
+  // The innovation, its covariance and NIS of an accepted update, onto the track's estimate.
+  template <int M>
+  void accept_update(const Eigen::Matrix<double, M, 1>& nu, const Eigen::Matrix<double, M, M>& S, double nis) {
+    if (!track_ || !track_->estimate) return;
+    Estimate& e = *track_->estimate;
+    e.updated = true;
+    e.innovation.resize(M);
+    e.innovation.template head<M>() = nu;
+    e.innovation_covariance.resize(M, M);
+    e.innovation_covariance.template topLeftCorner<M, M>() = S;
+    e.nis = nis;
+  }
+
+  // The predicted measurement of an estimator whose update reports its innovation (Self: the
+  // concrete estimator): an update of a copy with z = 0 gives nu = -h(x) (the azimuth wrapped)
+  // and S. Exact where S does not depend on z (linear and linearised updates, the unscented
+  // transform of h); it costs a copy and one update. The copy's warnings and counts go nowhere.
+  template <class Self>
+  bool predicted_by_update(const SensorFrame& s, const MeasCov& R, PredictedMeasurement& p) const {
+    struct Capture final : TrackContext {
+      void warn(const std::string&) override {}
+      void count(int) override {}
+      void annotate(int, double) override {}
+    } capture;
+    Estimate innovation;
+    capture.time = time();
+    capture.estimate = &innovation;
+    capture.who = who();
+    Self copy(static_cast<const Self&>(*this));
+    copy.bind(capture);
+    const int dim = static_cast<int>(R.rows());
+    Measurement m;
+    static_cast<SensorFrame&>(m) = s;
+    m.time = time();
+    m.has_range_rate = dim == 4;
+    m.value = MeasVec::Zero(dim);
+    m.covariance = R;
+    copy.measurement_noise() = R;
+    if (!static_cast<Estimator&>(copy).update(m, dim) || !innovation.updated || innovation.innovation.size() != dim) return false;
+    p.z = -innovation.innovation;
+    if (s.frame == Frame::Spherical) p.z(1) = wrap_angle(p.z(1));
+    p.S = innovation.innovation_covariance;
+    return set_log_det(p);
+  }
+
+  MeasCov R_;  // this update's measurement noise, exposed to adapters through noise()
+
+ private:
+  MeasurementSpec spec_;
+  TrackContext* track_ = nullptr;
+};
+
+}  // namespace trackflow

@@ -1,0 +1,219 @@
+// Purpose: the per-track estimator contract (estimator.hpp) held by every filter type that declares one: predict_measurement agrees with the update it predicts, clone() runs on identically, and the estimator alone gives what its filter node publishes.
+#include <trackflow/geometry.hpp>
+#include <trackflow/rng.hpp>
+#include <trackflow/single_track_filter.hpp>
+
+#include <Eigen/Cholesky>
+#include <catch2/catch.hpp>
+
+#include "plugin_fixture.hpp"
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+using namespace trackflow;
+
+namespace {
+
+// A target at ~20 km, climbing and turning gently, measured every 0.1 s by a radar at the
+// origin: spherical [r, az, el] (north-clockwise) or the same points in ENU.
+std::vector<Measurement> track(Frame frame, int steps) {
+  Rng rng(7);
+  std::vector<Measurement> out;
+  for (int k = 0; k < steps; ++k) {
+    const double t = 0.1 * k;
+    const Vec3 p(15000.0 + 200.0 * t, 12000.0 - 50.0 * t + 2.0 * t * t, 3000.0 + 20.0 * t);
+    Measurement m;
+    m.time = t;
+    m.frame = frame;
+    m.origin = 0;
+    if (frame == Frame::Spherical) {
+      const double r = p.norm(), az = std::atan2(p.x(), p.y()), el = std::asin(p.z() / r);
+      const Vec3 sigma(10.0, 1e-3, 1e-3);
+      m.value = Vec3(r + sigma(0) * rng.normal(), wrap_angle(az + sigma(1) * rng.normal()), el + sigma(2) * rng.normal());
+      m.covariance = Vec3(sigma.array().square()).asDiagonal();
+    } else {
+      m.value = p + 20.0 * Vec3(rng.normal(), rng.normal(), rng.normal());
+      m.covariance = MeasCov::Identity(3, 3) * 400.0;
+    }
+    out.push_back(m);
+  }
+  return out;
+}
+
+// What an estimator reports, collected as a single-track node would.
+struct Track final : TrackContext {
+  void warn(const std::string& w) override { warnings.push_back(w); }
+  void count(int) override {}
+  void annotate(int, double) override {}
+  Estimate e;
+  std::vector<std::string> warnings;
+};
+
+struct Case {
+  std::string type, params;
+  Frame frame;
+};
+
+const std::vector<Case>& cases() {
+  static const std::vector<Case> c = {
+      {"filter.kalman", "{q: 1 m2/s3}", Frame::Cartesian},
+      {"filter.kalman", "{motion: constant_acceleration}", Frame::Cartesian},
+      {"filter.decoupled", "{}", Frame::Cartesian},
+      {"filter.ekf", "{}", Frame::Spherical},
+      {"filter.ekf", "{motion: constant_acceleration}", Frame::Spherical},
+      {"filter.ukf", "{}", Frame::Spherical},
+      {"filter.ekf_spherical", "{}", Frame::Spherical},
+      {"filter.gain_transform", "{singer_alpha: 1 1/s, singer_sigma: 20 m/s2}", Frame::Spherical},
+      {"filter.imm", "{modes: [{motion: constant_velocity, q: 1 m2/s3}, {motion: constant_acceleration, q_jerk: 100 m2/s5}], transition: [0.95, 0.05, 0.05, 0.95]}", Frame::Spherical},
+      {"filter.imm", "{modes: [{motion: constant_acceleration}, {motion: singer, singer_alpha: 1 1/s, singer_sigma: 20 m/s2}], transition: [0.9, 0.1, 0.1, 0.9]}", Frame::Spherical},
+      {"filter.refraction_ekf", "{}", Frame::Spherical},
+  };
+  return c;
+}
+
+// Runs `e` over `ms` as the single-track node does (initiate until formed, then predict and
+// update), calling `before(m)` before and `after(m, used)` after every update once formed.
+template <class Before, class After>
+void run(Estimator& e, Track& t, const std::vector<Measurement>& ms, Before&& before, After&& after) {
+  e.bind(t);
+  t.estimate = &t.e;
+  bool formed = e.reset();
+  double last = 0.0;
+  for (const Measurement& m : ms) {
+    const double T = m.time - last;
+    last = t.time = m.time;
+    e.measurement_noise() = m.covariance;
+    if (!formed) {
+      formed = e.initiate(m, 3);
+      continue;
+    }
+    if (T > 0.0) e.predict(T);
+    before(m);
+    t.e.updated = false;
+    const bool used = e.update(m, 3);
+    after(m, used);
+  }
+}
+
+}  // namespace
+
+TEST_CASE("every filter with an estimator is covered") {
+  std::vector<std::string> declared;
+  for (const auto& r : test::registry().types())
+    if (r.decl.create_estimator && r.decl.type.rfind("filter.", 0) == 0) declared.push_back(r.decl.type);
+  for (const std::string& type : declared) {
+    bool covered = false;
+    for (const Case& c : cases()) covered = covered || c.type == type;
+    INFO(type);
+    CHECK(covered);
+  }
+  CHECK(declared.size() >= 8);
+}
+
+// predict_measurement gives the z^, S and log det S of the update that follows it.
+TEST_CASE("predicted measurement is what the update uses") {
+  for (const Case& c : cases()) {
+    INFO(c.type << " " << c.params);
+    auto e = test::fixture().make_estimator(c.type, c.params);
+    Track t;
+    PredictedMeasurement p;
+    bool predicted = false;
+    int checked = 0;
+    run(
+        *e, t, track(c.frame, 60),
+        [&](const Measurement& m) {
+          predicted = e->predict_measurement(m, m.covariance, p);
+          // Twice: predicting changes nothing.
+          PredictedMeasurement again;
+          if (predicted) {
+            REQUIRE(e->predict_measurement(m, m.covariance, again));
+            CHECK(again.log_det_S == p.log_det_S);
+          }
+        },
+        [&](const Measurement& m, bool used) {
+          if (!predicted || !used) return;
+          ++checked;
+          const MeasVec& nu = t.e.innovation;
+          const MeasCov& S = t.e.innovation_covariance;
+          REQUIRE(nu.size() == p.z.size());
+          REQUIRE(S.rows() == p.S.rows());
+          // log det S against an independent factorisation.
+          CHECK(p.log_det_S == Approx(std::log(Eigen::MatrixXd(p.S).determinant())).epsilon(1e-9));
+          // NIS and det S do not depend on the axes an update works in (filter.decoupled updates
+          // in the line-of-sight frame of each measurement): compared for every estimator.
+          const Eigen::MatrixXd Sd = S;
+          const Eigen::VectorXd nud = nu;
+          CHECK(std::log(Sd.determinant()) == Approx(p.log_det_S).epsilon(1e-8));
+          MeasVec r = m.value.head(p.z.size()) - p.z;
+          if (c.frame == Frame::Spherical) r(1) = wrap_angle(r(1));
+          const Eigen::VectorXd rd = r;
+          const Eigen::MatrixXd Sp = p.S;
+          CHECK(rd.dot(Sp.ldlt().solve(rd)) == Approx(nud.dot(Sd.ldlt().solve(nud))).epsilon(1e-7));
+          CHECK(t.e.nis == Approx(nud.dot(Sd.ldlt().solve(nud))).epsilon(1e-8));
+          if (c.type == "filter.decoupled") return;
+          // In the measurement's own axes: nu = z - z^ (azimuth wrapped) and the same S.
+          for (int i = 0; i < r.size(); ++i) CHECK(nu(i) == Approx(r(i)).epsilon(1e-9).margin(1e-9));
+          for (int i = 0; i < S.rows(); ++i)
+            for (int j = 0; j < S.cols(); ++j) CHECK(p.S(i, j) == Approx(S(i, j)).epsilon(1e-9).margin(1e-12));
+        });
+    CHECK(checked > 40);
+  }
+}
+
+TEST_CASE("a clone runs on exactly as its original") {
+  for (const Case& c : cases()) {
+    INFO(c.type << " " << c.params);
+    auto e = test::fixture().make_estimator(c.type, c.params);
+    const auto ms = track(c.frame, 60);
+    const std::vector<Measurement> first(ms.begin(), ms.begin() + 30), rest(ms.begin() + 30, ms.end());
+    Track t;
+    run(*e, t, first, [](const Measurement&) {}, [](const Measurement&, bool) {});
+    std::unique_ptr<Estimator> copy = e->clone();
+    Track tc = t;
+    copy->bind(tc);
+    tc.estimate = &tc.e;
+    for (const Measurement& m : rest) {
+      const double T = m.time - t.time;
+      for (auto* pair : {&t, &tc}) pair->time = m.time;
+      e->measurement_noise() = copy->measurement_noise() = m.covariance;
+      e->predict(T);
+      copy->predict(T);
+      REQUIRE(e->update(m, 3) == copy->update(m, 3));
+    }
+    Estimate a, b;
+    e->fill(a);
+    copy->fill(b);
+    CHECK(a.state == b.state);
+    CHECK(a.covariance == b.covariance);
+    CHECK(t.e.nis == tc.e.nis);
+  }
+}
+
+TEST_CASE("the estimator alone gives what its node publishes") {
+  for (const Case& c : cases()) {
+    INFO(c.type << " " << c.params);
+    auto node = test::make(c.type, c.params);
+    auto& filter = dynamic_cast<Filter&>(*node);
+    test::Collector out;
+    out.attach_to(filter);
+    test::start_run(filter);
+    const auto ms = track(c.frame, 40);
+    for (const Measurement& m : ms) filter.on_measurement(m, 0);
+    auto e = test::fixture().make_estimator(c.type, c.params);
+    Track t;
+    std::vector<Estimate> alone;
+    run(*e, t, ms, [](const Measurement&) {}, [&](const Measurement&, bool) {
+      Estimate x;
+      e->fill(x);
+      alone.push_back(x);
+    });
+    REQUIRE(!alone.empty());
+    REQUIRE(out.estimates.size() >= alone.size());
+    const Estimate& last_node = out.estimates.back();
+    CHECK(last_node.state == alone.back().state);
+    CHECK(last_node.covariance == alone.back().covariance);
+    CHECK(filter.state_layout().dim == e->layout().dim);
+  }
+}
