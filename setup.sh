@@ -31,9 +31,10 @@ case "$mode" in
     options=(-DTRACKFLOW_BUILD_TESTS=ON -DTRACKFLOW_BUILD_BENCH=OFF)
     ;;
   bench)
-    # The benchmarks (docs/performance.md), with OpenCV's cv::KalmanFilter as the Kalman step's peer;
-    # GNU time and python3 for the memory scripts (bench/memory_hostile.sh, bench/memory_long_log.sh).
-    packages+=(libopencv-video-dev time python3)
+    # The benchmarks (docs/performance.md), with OpenCV's cv::KalmanFilter as the Kalman step's peer
+    # and {fmt} as std::to_chars' (trackflow-bench-number-format); GNU time and python3 for the
+    # memory scripts (bench/memory_hostile.sh, bench/memory_long_log.sh).
+    packages+=(libopencv-video-dev libfmt-dev time python3)
     options=(-DTRACKFLOW_BUILD_TESTS=OFF -DTRACKFLOW_BUILD_BENCH=ON)
     ;;
 esac

@@ -62,6 +62,7 @@ for b in old new; do
 done
 cmp -s "$OUT/old.html" "$OUT/new.html" && echo "report.html: identical (apart from --out and the elapsed time)" ||
   echo "report.html: DIFFERS"
-cmp -s "$OUT/old.csv/log.csv" "$OUT/new.csv/log.csv" && echo "log.csv: identical" || echo "log.csv: DIFFERS"
+cmp -s "$OUT/old.csv/log.csv" "$OUT/new.csv/log.csv" && echo "log.csv: identical" ||
+  echo "log.csv: DIFFERS (expected between builds before and after sink.csv's shortest round-trip default)"
 diff -r -q -x report.html "$OUT/old.report" "$OUT/new.report" > /dev/null && echo "series and track CSVs: identical" ||
   echo "series and track CSVs: DIFFER"

@@ -105,6 +105,28 @@ TEST_CASE("number_text: general equals snprintf %.*g, all precisions") {
   CHECK(compared > 1000000);
 }
 
+TEST_CASE("number_text: write_* equal the append_* forms") {
+  const auto values = awkward_values();
+  char buf[nt::kWriteRoom + 8];
+  for (double v : values) {
+    for (int precision : {0, 1, 6, 10, 12, 15, 16, 17, -1}) {
+      std::memset(buf, '#', sizeof buf);
+      char* end = nt::write_general(buf, v, precision);
+      REQUIRE(end <= buf + nt::kWriteRoom);
+      const std::string want = printf_text("%.*g", precision, v);
+      if (std::string(buf, end) != want)
+        FAIL("write_general %." << precision << "g of " << printf_text("%.*a", 13, v) << ": " << std::string(buf, end));
+      CHECK(buf[nt::kWriteRoom] == '#');
+    }
+    char* end = nt::write_shortest(buf, v);
+    REQUIRE(end <= buf + nt::kWriteRoom);
+    if (std::string(buf, end) != nt::shortest(v)) FAIL("write_shortest of " << printf_text("%.*a", 13, v));
+  }
+  const std::uint64_t max = std::numeric_limits<std::uint64_t>::max();
+  CHECK(std::string(buf, nt::write_unsigned(buf, max)) == "18446744073709551615");
+  CHECK(std::string(buf, nt::write_unsigned(buf, 0)) == "0");
+}
+
 TEST_CASE("number_text: fixed equals snprintf %.*f, also long texts") {
   const auto values = awkward_values();
   for (int precision : {0, 1, 2, 3, 4, 6, 10, 17, 30})

@@ -1,4 +1,4 @@
-// Purpose: numbers as output text through std::to_chars: byte-identical to printf's "%.*g" and "%.*f", shortest round-trip, unsigned integers.
+// Purpose: numbers as output text through std::to_chars: byte-identical to printf's "%.*g" and "%.*f", shortest round-trip, unsigned integers; appended to a string or written into a caller's buffer.
 #pragma once
 
 #include <charconv>
@@ -40,6 +40,25 @@ void append(std::string& out, double v, std::size_t worst, Format... format) {
 inline std::size_t worst_case(int precision) { return 330 + static_cast<std::size_t>(precision < 0 ? 6 : precision); }
 
 }  // namespace detail
+
+// Room a write_* call below needs at `first`: any shortest text ("-1.2345678901234567e-308" is 24
+// characters), any "%.*g" up to precision 17 (sign, 17 digits, point and "e-308", or "0.000"
+// before the digits: at most 24), any unsigned 64-bit integer (20 digits). For a writer that
+// assembles many numbers in its own buffer (sink.csv's rows): no string growth per number.
+inline constexpr std::size_t kWriteRoom = 32;
+
+// The shortest text that reads back as exactly `v` (as append_shortest), written at `first`
+// (kWriteRoom characters of room); returns the end of the text.
+inline char* write_shortest(char* first, double v) noexcept { return std::to_chars(first, first + kWriteRoom, v).ptr; }
+
+// printf("%.*g", precision, v) for precision <= 17 (as append_general), written at `first`
+// (kWriteRoom characters of room); returns the end of the text. Larger precisions: append_general.
+inline char* write_general(char* first, double v, int precision) noexcept {
+  return std::to_chars(first, first + kWriteRoom, v, std::chars_format::general, precision).ptr;
+}
+
+// printf("%llu", v), written at `first` (kWriteRoom characters of room); returns the end.
+inline char* write_unsigned(char* first, std::uint64_t v) noexcept { return std::to_chars(first, first + kWriteRoom, v).ptr; }
 
 // printf("%.*g", precision, v), appended.
 inline void append_general(std::string& out, double v, int precision) {

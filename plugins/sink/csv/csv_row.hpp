@@ -1,10 +1,12 @@
-// Purpose: appends CSV cells to a reused string buffer: "%.*g" numbers (std::to_chars), empty cells for missing values, "nan"/"inf" (counted) for non-finite ones.
+// Purpose: assembles CSV rows in a stack buffer appended to a reused string once a row: numbers through number_text (shortest round-trip or "%.*g"), empty cells for missing values, "nan"/"inf" (counted) for non-finite ones.
 #pragma once
 
 #include <trackflow/number_text.hpp>
 
 #include <cmath>
+#include <cstddef>
 #include <cstdint>
+#include <cstring>
 #include <string>
 #include <string_view>
 
@@ -12,18 +14,25 @@ namespace trackflow::csv {
 
 class RowWriter {
  public:
+  // `precision`: significant digits ("%.*g", 1 to 17), or kShortest: the shortest text that reads
+  // back as exactly the same double (std::from_chars, strtod; lossless).
+  static constexpr int kShortest = 0;
+
   RowWriter(std::string& out, int precision) : out_(out), precision_(precision) {}
+  RowWriter(const RowWriter&) = delete;
+  RowWriter& operator=(const RowWriter&) = delete;
+  ~RowWriter() { flush(); }
 
   // A value that exists. Non-finite ones are written as they are ("nan", "inf", "-inf") -- an
   // empty cell means "no value", which a NaN is not -- and counted, so the sink can fail the run.
   void real(double v) {
-    separate();
+    cell(number_text::kWriteRoom);
     if (!std::isfinite(v)) {
-      out_.append(std::isnan(v) ? "nan" : v > 0 ? "inf" : "-inf");
+      put(std::isnan(v) ? "nan" : v > 0 ? "inf" : "-inf");
       if (non_finite_++ == 0) first_non_finite_ = column_;
       return;
     }
-    number_text::append_general(out_, v, precision_);
+    at_ = precision_ == kShortest ? number_text::write_shortest(at_, v) : number_text::write_general(at_, v, precision_);
   }
   void real_if(bool present, double v) {
     if (present)
@@ -32,16 +41,24 @@ class RowWriter {
       empty();
   }
   void integer(std::uint64_t v) {
-    separate();
-    number_text::append_unsigned(out_, v);
+    cell(number_text::kWriteRoom);
+    at_ = number_text::write_unsigned(at_, v);
   }
   void text(std::string_view s) {
-    separate();
-    out_.append(s);
+    if (s.size() > kLongText) {  // past the buffer: straight into the string
+      cell(0);
+      flush();
+      out_.append(s);
+      return;
+    }
+    cell(s.size());
+    put(s);
   }
-  void empty() { separate(); }
+  void empty() { cell(0); }
   void end() {
-    out_.push_back('\n');
+    if (at_ == buf_ + sizeof buf_) flush();
+    *at_++ = '\n';
+    flush();
     first_ = true;
     column_ = 0;
   }
@@ -50,17 +67,35 @@ class RowWriter {
   int first_non_finite_column() const { return first_non_finite_; }
 
  private:
-  void separate() {
-    if (!first_) out_.push_back(',');
-    if (!first_) ++column_;
+  static constexpr std::size_t kLongText = 256;
+
+  // A separator (unless first in the row) with room for `n` characters after it.
+  void cell(std::size_t n) {
+    if (static_cast<std::size_t>(buf_ + sizeof buf_ - at_) < n + 1) flush();
+    if (!first_) {
+      *at_++ = ',';
+      ++column_;
+    }
     first_ = false;
   }
+  void put(std::string_view s) {
+    std::memcpy(at_, s.data(), s.size());
+    at_ += s.size();
+  }
+  // One append a row (or a buffer full), not one per cell.
+  void flush() {
+    out_.append(buf_, static_cast<std::size_t>(at_ - buf_));
+    at_ = buf_;
+  }
+
   std::string& out_;
   int precision_;
   bool first_ = true;
   int column_ = 0;
   int non_finite_ = 0;
   int first_non_finite_ = -1;
+  char buf_[2048];
+  char* at_ = buf_;
 };
 
 // A field quoted per RFC 4180 when it holds a separator, a quote or a line break.

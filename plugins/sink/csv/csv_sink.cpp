@@ -127,14 +127,13 @@ class CsvSink final : public Component, public RunResultCodec {
         node_(p.node()),
         include_measurements_(p.boolean("include_measurements")),
         full_covariance_(p.boolean("full_covariance")),
-        precision_(static_cast<int>(p.integer("precision"))) {
+        precision_(p.has("precision") ? static_cast<int>(p.integer("precision")) : csv::RowWriter::kShortest) {
     if (p.has("path") && path_.empty()) throw p.error("path", "must not be empty (leave it out for '<node id>.csv')");
     // A pipeline file from someone else must not write anywhere but under --out.
     if (std::string why = output_path_problem(path_); !why.empty())
       throw p.error("path", why + " (pass --allow-outside-out on the command line to allow it)");
     truth_.reserve(4096);
     pending_.reserve(1024);
-    rows_.reserve(std::size_t{1} << 20);
   }
 
   ~CsvSink() override {
@@ -245,7 +244,17 @@ class CsvSink final : public Component, public RunResultCodec {
     flush(true);
     auto r = std::make_unique<CsvRunResult>();
     r->spilled = std::move(spill_);
-    r->rows = rows_;
+    // The text moves into the result (no copy of the run's text) unless that would leave it
+    // holding more than twice its size (a run smaller than an earlier one, or a spilled run's
+    // tail): then it is copied. The next run starts with room for as much as this one.
+    const std::size_t size = rows_.size();
+    if (rows_.capacity() / 2 <= size) {
+      r->rows = std::move(rows_);
+      rows_ = std::string();
+      rows_.reserve(size);
+    } else {
+      r->rows = rows_;
+    }
     r->count = row_count_;
     r->non_finite = non_finite_;
     r->first_non_finite = first_non_finite_;
@@ -515,7 +524,7 @@ class CsvSink final : public Component, public RunResultCodec {
   const std::string node_;
   const bool include_measurements_;
   const bool full_covariance_;
-  const int precision_;
+  const int precision_;  // csv::RowWriter::kShortest unless given
   std::vector<std::string> sources_;
   std::vector<std::string> annotation_columns_;
   std::vector<std::vector<int>> column_of_;  // per input port: annotation index -> column
@@ -570,7 +579,10 @@ void register_components(Registrar& r) {
       ParamSpec::boolean("full_covariance",
                          "also write the upper triangle of the ENU covariance (cov_x_x ... cov_vz_vz; m2, m2/s, m2/s2)")
           .def("false"),
-      ParamSpec::integer("precision", "significant digits of numbers").def("10").at_least(1).at_most(17),
+      ParamSpec::integer("precision", "significant digits of numbers (printf %.Ng); left out: the shortest text that "
+                                      "reads back as exactly the same double (lossless, e.g. 0.1, 6123.456789012345, 1e-05)")
+          .at_least(1)
+          .at_most(17),
   };
   d.accepts = ItemKind::Estimate | ItemKind::Truth | mask(ItemKind::Measurement);
   d.min_inputs = 1;

@@ -7,8 +7,13 @@
 #include <Eigen/Dense>
 #include <catch2/catch.hpp>
 
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
+#include <random>
 #include <functional>
 #include <sstream>
 #include <string>
@@ -151,6 +156,15 @@ std::string ensemble_file(const fs::path& dir, const std::vector<std::uint64_t>&
 }
 
 double num(const std::string& cell) { return std::stod(cell); }
+
+// Ends the one run of `c`, merges it, finishes the file in `dir` and returns its rows (the header first).
+std::vector<std::vector<std::string>> finished_rows(Component& c, const fs::path& dir) {
+  auto result = c.end_run();
+  c.merge(*result);
+  Summary s;
+  c.finish(s, {"log", dir.string(), 1});
+  return parse(slurp(dir / "log.csv"));
+}
 
 }  // namespace
 
@@ -352,6 +366,54 @@ TEST_CASE("relative path and precision") {
   CHECK(rows[1][X] == "1.235e+05");
   CHECK(rows[1][TX].empty());
   CHECK_THROWS_AS(test::make("sink.csv", "{ precision: 0 }"), ConfigError);
+}
+
+// without precision every number is the shortest text that reads back as exactly the same
+// double: lossless, the form of std::to_chars (e.g. 0.1, 1e-05, -0, 1.7976931348623157e+308)
+TEST_CASE("numbers are shortest round-trip by default") {
+  const fs::path dir = scratch("shortest");
+  auto c = make_csv("{}", {kKf, kTruth});
+  Diagnostics diag;
+  c->start_run({0, 1, &diag});
+  std::mt19937_64 gen(11);
+  std::vector<Vec6> written;
+  const double awkward[] = {0.1, 1e-05, -0.0, 1e20, 5e-324, 2.2250738585072014e-308, 1.7976931348623157e308,
+                            -123456.78901234567, 6123.456789012345, 100, 1.5, 0.30000000000000004};
+  for (int k = 0; k < 200; ++k) {
+    Vec6 x;
+    for (int i = 0; i < 6; ++i) {
+      if (k < 2) {
+        x(i) = awkward[(6 * k + i) % std::size(awkward)];
+        continue;
+      }
+      std::uint64_t bits = gen();
+      std::memcpy(&x(i), &bits, sizeof bits);
+      if (!std::isfinite(x(i))) x(i) = 1.0 / (k + i + 1);
+    }
+    written.push_back(x);
+    c->on_estimate(estimate(0.1 * k, x, Mat6::Identity()), 0);
+  }
+  const auto rows = finished_rows(*c, dir);
+  REQUIRE(rows.size() == 201);
+  CHECK(rows[1][X] == "0.1");
+  CHECK(rows[1][Y] == "1e-05");
+  CHECK(rows[1][Z] == "-0");
+  CHECK(rows[1][VX] == "1e+20");
+  CHECK(rows[1][VY] == "5e-324");
+  CHECK(rows[2][X] == "1.7976931348623157e+308");
+  CHECK(rows[2][Z] == "6123.456789012345");
+  CHECK(rows[2][VX] == "100");
+  CHECK(rows[3][Time] == "0.2");
+  CHECK(rows[4][Time] == "0.30000000000000004");  // 0.1 * 3
+  for (std::size_t k = 0; k < written.size(); ++k)
+    for (int i = 0; i < 6; ++i) {
+      const std::string& cell = rows[k + 1][X + i];
+      const double back = std::strtod(cell.c_str(), nullptr);
+      if (std::memcmp(&back, &written[k](i), sizeof back) != 0) FAIL("row " << k << ": " << cell << " does not read back");
+      char longest[32];
+      std::snprintf(longest, sizeof longest, "%.17g", written[k](i));
+      CHECK(cell.size() <= std::strlen(longest));
+    }
 }
 
 // with an output folder known (as in the engine) rows are streamed at merge time, in run order
