@@ -61,6 +61,7 @@ void Ensemble::add(const MetricsRunResult& run) {
   measurement_sq_error += run.measurement_sq_error;
   measurements_matched += run.measurements_matched;
   measurements_unmatched += run.measurements_unmatched;
+  if (run.sums.used) add_sums(run.sums);
   // Steps this run reaches for the first time are created before anything is added, so every
   // step's sums grow in run order and, within a run, in record order (estimates, then
   // measurements), as with a map.
@@ -134,6 +135,27 @@ void Ensemble::add(const MetricsRunResult& run) {
   }
 }
 
+void Ensemble::add_sums(const RunSums& r) {
+  summed_steps_differ = summed_steps_differ || (summed && (r.fingerprint != summed_fingerprint || r.steps != summed_steps));
+  if (!summed) {
+    summed_fingerprint = r.fingerprint;
+    summed_steps = r.steps;
+  }
+  summed = true;
+  summed_steps = std::max(summed_steps, r.steps);  // the most of one run, when the runs differ
+  summed_anis += r.anis_sum;
+  summed_nis_steps += r.nis_steps;
+  summed_nis_dof += r.nis_dof;
+  summed_nis_count += r.nis_count;
+  estimates += r.scored;
+  nis_dof_min = std::min(nis_dof_min, r.nis_dof_min);
+  nis_dof_max = std::max(nis_dof_max, r.nis_dof_max);
+  for (int i = 0; i < kMaxMeasDim; ++i) {
+    innovation_sum[i] += r.innovation_sum[i];
+    innovation_count[i] += r.innovation_count[i];
+  }
+}
+
 namespace {
 
 std::string count_text(std::uint64_t n, const char* what) {
@@ -168,13 +190,23 @@ void report_anis(const Ensemble& e, const ReportOptions& opt, Summary& s) {
     total += st.nis / static_cast<double>(st.nis_dof);
     ++n;
   }
+  // Runs without a step table (RunSums): the mean over runs and steps of each run's step value,
+  // which is the mean over steps of the ensemble's when all runs share their steps.
+  if (e.summed) {
+    total = e.summed_anis;
+    n = e.summed_nis_steps;
+    if (n && e.summed_steps_differ)
+      s.notes.push_back("anis: the runs differ in their time steps or innovation dimensions, and without truth and "
+                        "series no per-step table is kept, so anis is the mean over every run's steps (steps: the "
+                        "most of one run); series: true gives the per-step ensemble mean");
+  }
   if (n == 0) {
     s.notes.push_back("anis not reported: no updated estimate carries an innovation");
     return;
   }
   int dof = e.nis_dof_max;
   if (e.nis_dof_min != e.nis_dof_max) {
-    std::uint64_t dof_sum = 0, count = 0;
+    std::uint64_t dof_sum = e.summed_nis_dof, count = e.summed_nis_count;
     for (const auto& [key, st] : e.steps) {
       dof_sum += st.nis_dof;
       count += st.nis_count;
@@ -282,6 +314,7 @@ void report(const Ensemble& e, const ReportOptions& opt, Summary& s) {
   const bool truth_mode = opt.truth_input || e.runs_with_truth > 0;
   std::uint64_t steps = 0;
   for (const auto& [key, st] : e.steps) steps += (truth_mode ? st.matched : st.estimates) > 0 ? 1 : 0;
+  if (e.summed && !truth_mode) steps = e.summed_steps;
 
   if (truth_mode) {
     double position_rmse = -1.0;

@@ -43,6 +43,29 @@ struct MeasurementRecord {
   double sq_error = 0.0;
 };
 
+// A run's own sums for the one case that keeps nothing per step: a streaming run (time-ordered
+// inputs) without truth and without series, e.g. a recorded log. Each step of the run adds its
+// NIS / dof at once; the ensemble's ANIS is then their mean over runs and steps, equal to the mean
+// over steps of the per-step ensemble mean when every run has the same steps and innovation
+// dimensions (`fingerprint` tells) -- only the order of the sums differs (about 1e-16 relative).
+struct RunSums {
+  bool used = false;
+  std::uint64_t scored = 0;      // scored estimates
+  std::uint64_t steps = 0;       // time steps with a scored estimate
+  std::uint64_t nis_steps = 0;   // time steps with an innovation
+  double anis_sum = 0.0;         // sum over those steps of (sum of NIS) / (sum of dof)
+  std::uint64_t nis_dof = 0, nis_count = 0;
+  double innovation_sum[kMaxMeasDim] = {};
+  std::uint64_t innovation_count[kMaxMeasDim] = {};
+  int nis_dof_min = kMaxMeasDim + 1, nis_dof_max = 0;
+  std::uint64_t fingerprint = 0;  // of every step's key, dof sum and whether it has a scored estimate
+  template <class Self, class F>
+  static void fields(Self& s, F&& f) {
+    f(s.used, s.scored, s.steps, s.nis_steps, s.anis_sum, s.nis_dof, s.nis_count, s.innovation_sum,
+      s.innovation_count, s.nis_dof_min, s.nis_dof_max, s.fingerprint);
+  }
+};
+
 struct MetricsRunResult final : RunResult {
   std::vector<EstimateRecord> records;
   std::vector<MeasurementRecord> measurement_records;
@@ -54,12 +77,16 @@ struct MetricsRunResult final : RunResult {
   // Measurement baseline of this run (a sum over one run is fixed by the run's own item order).
   double measurement_sq_error = 0.0;
   std::uint64_t measurements_matched = 0, measurements_unmatched = 0;
+  RunSums sums;
+  // Streaming runs: the most estimates that waited for their truth at once (tests, diagnostics).
+  std::uint64_t pending_high_water = 0;
   // A run's records as bytes and back, exactly (mpirun: run_result_codec.hpp's FieldListCodec);
   // the estimate records go one by one with their own list, the measurement records as one block.
   template <class Self, class F>
   static void fields(Self& r, F&& f) {
     f(r.records, r.measurement_records, r.had_truth, r.before_window, r.non_finite, r.unmatched,
-      r.not_positive_definite, r.measurement_sq_error, r.measurements_matched, r.measurements_unmatched);
+      r.not_positive_definite, r.measurement_sq_error, r.measurements_matched, r.measurements_unmatched, r.sums,
+      r.pending_high_water);
   }
 };
 
@@ -94,10 +121,17 @@ struct Ensemble {
   std::uint64_t innovation_count[kMaxMeasDim] = {};
   int nis_dof_min = kMaxMeasDim + 1, nis_dof_max = 0;
   int annotation_channels = 0;
+  // Runs merged from RunSums (no per-step table): their sums in run order, and whether the runs'
+  // step structures (RunSums::fingerprint) differ.
+  bool summed = false, summed_steps_differ = false;
+  double summed_anis = 0.0;
+  std::uint64_t summed_steps = 0, summed_nis_steps = 0, summed_nis_dof = 0, summed_nis_count = 0;
+  std::uint64_t summed_fingerprint = 0;
 
   void add(const MetricsRunResult& run);
 
  private:
+  void add_sums(const RunSums& r);
   std::vector<long long> missing_;  // add()'s scratch: keys of the run not yet in steps
 };
 

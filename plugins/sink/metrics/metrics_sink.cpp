@@ -1,6 +1,7 @@
 // Purpose: sink.metrics — ensemble RMSE, bias, ANEES and ANIS (with chi-square bands) of one filter against truth.
 #include "ensemble.hpp"
-#include "scoring/nees.hpp"
+#include "stream_scorer.hpp"
+#include "record_scoring.hpp"
 #include "scoring/truth_match.hpp"
 
 #include <trackflow/geometry.hpp>
@@ -24,9 +25,13 @@ using metrics::MetricsRunResult;
 // (the state after every update of that time).
 enum class SameTime { All, Last };
 
-// Items are only stored during a run; everything is evaluated in end_run(), when the truth of
-// the whole run is known (truth of a time step may arrive after the estimate of that step).
-// Per-run records cross processes under mpirun by MetricsRunResult's field list (ensemble.hpp).
+// When every input is time-ordered (InputInfo::time_ordered) a run is scored as it arrives
+// (stream_scorer.hpp): an estimate as soon as its truth is certain, so only those still waiting
+// for truth are kept, and without truth or series nothing per step. Otherwise items are stored
+// during the run and everything is evaluated in end_run(), when the truth of the whole run is
+// known (truth of a time step may arrive after the estimate of that step, and out of order).
+// Both give the same records; they cross processes under mpirun by MetricsRunResult's field
+// list (ensemble.hpp).
 class MetricsSink final : public Component, public FieldListCodec<MetricsRunResult> {
  public:
   explicit MetricsSink(const Params& p)
@@ -37,16 +42,13 @@ class MetricsSink final : public Component, public FieldListCodec<MetricsRunResu
         last_at_time_(p.choice<SameTime>("same_time") == SameTime::Last) {
     if (!(confidence_ > 0.0 && confidence_ < 1.0))
       throw p.error("confidence", "must lie strictly between 0 and 1 (e.g. 0.95)");
-    constexpr size_t kReserve = 4096;
-    truth_.reserve(kReserve);
-    estimates_.reserve(kReserve);
-    measurements_.reserve(kReserve);
     ensemble_.annotation_channels = series_ ? channels_.count() : 0;
   }
 
   void set_inputs(const std::vector<InputInfo>& inputs) override {
     std::string estimate_sources;
     int estimate_inputs = 0;
+    bool streaming = !inputs.empty();
     for (const auto& in : inputs) {
       if (in.kinds & mask(ItemKind::Estimate)) {
         estimate_sources += (estimate_inputs++ ? ", '" : "'") + in.node + "'";
@@ -55,7 +57,13 @@ class MetricsSink final : public Component, public FieldListCodec<MetricsRunResu
       }
       truth_input_ |= (in.kinds & mask(ItemKind::Truth)) != 0;
       measurement_input_ |= (in.kinds & mask(ItemKind::Measurement)) != 0;
+      streaming &= in.time_ordered;
     }
+    streaming_ = streaming;
+    if (streaming_)
+      scorer_.configure({skip_initial_, tolerance_, series_, last_at_time_, truth_input_, estimate_inputs > 0,
+                         measurement_input_, !truth_input_ && !series_},
+                        &channels_);
     if (estimate_inputs > 1)
       throw ConfigError("inputs " + estimate_sources +
                         " all deliver estimates, but the metrics of one filter are computed per node: "
@@ -63,6 +71,11 @@ class MetricsSink final : public Component, public FieldListCodec<MetricsRunResu
   }
 
   void start_run(const RunContext&) override {
+    if (streaming_) return scorer_.start_run();
+    constexpr size_t kReserve = 4096;  // the stored path's buffers (a no-op after the first run)
+    truth_.reserve(kReserve);
+    estimates_.reserve(kReserve);
+    measurements_.reserve(kReserve);
     truth_nan_time_ = false;
     truth_.clear();
     estimates_.clear();
@@ -70,12 +83,14 @@ class MetricsSink final : public Component, public FieldListCodec<MetricsRunResu
   }
 
   void on_truth(const Truth& t, int) override {
+    if (streaming_) return scorer_.on_truth(t);
     truth_nan_time_ = truth_nan_time_ || std::isnan(t.time);
     metrics::insert_truth(truth_, t);
   }
 
   // Every estimate is kept (uninitialised ones only count towards the per-step fractions).
   void on_estimate(const Estimate& e, int) override {
+    if (streaming_) return scorer_.on_estimate(e);
     if (!e.initialised && !series_) return;
     const bool replace = last_at_time_ && !estimates_.empty() && std::abs(e.time - estimates_.back().time) <= tolerance_;
     StoredEstimate& s = replace ? estimates_.back() : estimates_.emplace_back();
@@ -97,10 +112,12 @@ class MetricsSink final : public Component, public FieldListCodec<MetricsRunResu
     const Vec3 p = m.frame == Frame::Cartesian
                        ? Vec3(m.value.head<3>())
                        : measured_position(m);
+    if (streaming_) return scorer_.on_measurement(m.time, p);
     measurements_.push_back({m.time, p});
   }
 
   std::unique_ptr<RunResult> end_run() override {
+    if (streaming_) return scorer_.end_run();
     auto r = std::make_unique<MetricsRunResult>();
     r->had_truth = !truth_.empty();
     r->records.reserve(estimates_.size());
@@ -171,29 +188,14 @@ class MetricsSink final : public Component, public FieldListCodec<MetricsRunResu
   }
 
   void evaluate(const StoredEstimate& e, EstimateRecord& rec, MetricsRunResult& r) const {
-    rec.scored = true;
-    const int m = static_cast<int>(e.innovation.size());
-    if (e.updated && m > 0 && std::isfinite(e.nis)) {
-      rec.nis_dof = m;
-      rec.nis = e.nis;
-      rec.innovation.head(m) = e.innovation;
-    }
+    metrics::score_innovation(rec, e.updated, e.nis, e.innovation);
     Vec6 truth;
     if (!metrics::truth_at(metrics::truth_for(truth_, e.target), e.time, tolerance_, truth,
                            use_cursor_ ? &cursor_ : nullptr)) {
       ++r.unmatched;
       return;
     }
-    rec.matched = true;
-    rec.error = e.enu - truth;
-    // NEES and position NEES from one factorisation of the covariance (nees.hpp).
-    double terms[6];
-    if (e.covariance.allFinite() && metrics::nees_terms(e.covariance, rec.error, terms)) {
-      rec.nees_position = terms[0] + terms[1] + terms[2];
-      rec.nees = rec.nees_position + terms[3] + terms[4] + terms[5];
-      rec.has_nees = std::isfinite(rec.nees) && std::isfinite(rec.nees_position);
-    }
-    if (!rec.has_nees) ++r.not_positive_definite;
+    metrics::score_error(rec, e.enu, e.covariance, truth, r);
   }
 
   void measurement_errors(double start, MetricsRunResult& r) const {
@@ -205,20 +207,17 @@ class MetricsSink final : public Component, public FieldListCodec<MetricsRunResu
     for (const auto& m : measurements_) {
       if (m.time + tolerance_ < start) continue;
       Vec6 truth;
-      if (usable && metrics::truth_at(span, m.time, tolerance_, truth, from)) {
-        const double sq = (m.position - truth.head<3>()).squaredNorm();
-        r.measurement_sq_error += sq;
-        ++r.measurements_matched;
-        if (series_) r.measurement_records.push_back({std::llround(m.time / tolerance_), m.time, sq});
-      } else {
-        ++r.measurements_unmatched;
-      }
+      const bool matched = usable && metrics::truth_at(span, m.time, tolerance_, truth, from);
+      metrics::add_measurement(r, m.time, matched, matched ? (m.position - truth.head<3>()).squaredNorm() : 0.0,
+                               tolerance_, series_);
     }
   }
 
   const double skip_initial_, confidence_, tolerance_;
   const bool series_, last_at_time_;
   bool truth_input_ = false, measurement_input_ = false;
+  bool streaming_ = false;  // every input time-ordered: scorer_ takes the items
+  metrics::StreamScorer scorer_;
   bool truth_nan_time_ = false;  // a truth sample without a time: samples not in time order
   std::vector<Truth> truth_;
   // end_run's truth lookups (evaluate): where the last one ended, and whether to start there.
@@ -243,7 +242,11 @@ void register_components(Registrar& r) {
       "step (n = 6, or 3 for anees_position); anees is its mean over steps, with the per-step band "
       "[chi2inv((1-c)/2, nM), chi2inv((1+c)/2, nM)]/(nM) (Bar-Shalom, Li & Kirubarajan 2001 §5.4.2). ANIS "
       "likewise with the innovation dimension. Without truth (recorded logs) only anis, mean_innovation_<i> "
-      "and counts are reported. Only initialised estimates are scored. Per time step it also publishes the "
+      "and counts are reported. Only initialised estimates are scored. When every input is time-ordered (its "
+      "sources declare so, e.g. sim.trajectory, source.csv) a run is scored as it arrives: an estimate as soon as "
+      "its truth is certain, with only those still waiting for truth kept; without truth and with series: false "
+      "nothing is kept per step, and anis is summed per run (the same mean when the runs share their time steps, "
+      "else a note). Per time step it also publishes the "
       "ensemble series (`trackflow run --series`, `trackflow report`): position/velocity RMSE, mean error per axis, "
       "ANEES and ANIS with the band for the runs at that step, measurement RMSE, fractions of runs initialised and "
       "updated, and the mean of each adapter annotation (e.g. quality grades, adapted sigmas); the series' mean ANEES "

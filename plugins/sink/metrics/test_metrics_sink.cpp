@@ -5,10 +5,14 @@
 #include <Eigen/Dense>
 #include <catch2/catch.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <functional>
 #include <string>
+#include <vector>
 
+#include "ensemble.hpp"
+#include "stream_scorer.hpp"
 #include "plugin_fixture.hpp"
 
 using namespace trackflow;
@@ -366,4 +370,206 @@ TEST_CASE("metrics: same_time last scores the last estimate only") {
   CHECK(all.find("estimates")->value == 3);
   CHECK(last.find("position_rmse")->value == Approx(0.0).margin(1e-12));
   CHECK(last.find("estimates")->value == 2);
+}
+
+// ---- Streaming (every input time-ordered, stream_scorer.hpp) against the stored path ----
+
+namespace {
+
+InputInfo ordered(InputInfo in) {
+  in.time_ordered = true;
+  return in;
+}
+
+// A run as a simulation delivers it, in time order: truth every `truth_every` steps of 0.1 s
+// (estimates between samples are interpolated), each sample `truth_lag` steps after the
+// estimate of its time (0: right after it, as the engine delivers a sim pipeline's step), a
+// measurement per step, uninitialised estimates first, coasting steps, and a second estimate
+// at some time stamps (a filter with two sensors). truth_every 0: no truth (a recorded log).
+void feed_run(Component& c, int run, int steps, int truth_every, int truth_lag) {
+  Rng rng(1000 + static_cast<std::uint64_t>(run));
+  std::vector<Truth> samples;
+  for (int k = 0; truth_every > 0 && k <= steps + truth_every; k += truth_every)
+    samples.push_back(truth(0.1 * k, Vec3(1000 + 30.0 * 0.1 * k, 200, 50), Vec3(30, 0, 0)));
+  std::size_t next_truth = 0;
+  auto truth_until = [&](double t) {
+    while (next_truth < samples.size() && samples[next_truth].time <= t + 1e-9) c.on_truth(samples[next_truth++], 1);
+  };
+  for (int k = 0; k < steps; ++k) {
+    const double t = 0.1 * k;
+    Vec6 x;
+    x << 1000 + 30.0 * t, 200, 50, 30, 0, 0;
+    Measurement m;
+    m.time = t;
+    m.frame = Frame::Cartesian;
+    m.valid = true;
+    m.value.resize(3);
+    m.value << x(0) + 5 * rng.normal(), x(1) + 5 * rng.normal(), x(2) + 5 * rng.normal();
+    c.on_measurement(m, 2);
+    for (int copy = 0; copy < (k % 7 == 3 ? 2 : 1); ++copy) {
+      Vec6 err;
+      for (int i = 0; i < 6; ++i) err(i) = 3 * rng.normal();
+      Estimate e = estimate(t, x + err, random_covariance(rng));
+      e.initialised = k >= 2;
+      e.updated = k % 5 != 4;
+      e.innovation.resize(e.updated ? 3 : 0);
+      if (e.updated) e.innovation << rng.normal(), rng.normal(), rng.normal();
+      e.nis = e.updated ? e.innovation.squaredNorm() : 0.0;
+      c.on_estimate(e, 0);
+    }
+    truth_until(t - 0.1 * truth_lag);
+  }
+  truth_until(1e9);
+}
+
+void check_same(const Summary& a, const Summary& b) {
+  REQUIRE(a.metrics.size() == b.metrics.size());
+  for (std::size_t i = 0; i < a.metrics.size(); ++i) {
+    INFO(a.metrics[i].name);
+    CHECK(a.metrics[i].name == b.metrics[i].name);
+    CHECK(a.metrics[i].value == b.metrics[i].value);  // bit for bit
+    CHECK(a.metrics[i].band_lo == b.metrics[i].band_lo);
+    CHECK(a.metrics[i].band_hi == b.metrics[i].band_hi);
+  }
+  CHECK(a.notes == b.notes);
+  REQUIRE(a.series.size() == b.series.size());
+  for (std::size_t i = 0; i < a.series.size(); ++i) {
+    REQUIRE(a.series[i].values.size() == b.series[i].values.size());
+    for (std::size_t j = 0; j < a.series[i].values.size(); ++j) {
+      const double x = a.series[i].values[j], y = b.series[i].values[j];
+      CHECK(((std::isnan(x) && std::isnan(y)) || x == y));
+    }
+  }
+}
+
+// Runs `runs` runs through a worker whose inputs are time-ordered; the high water of each run's
+// queue of estimates waiting for truth goes to `high_water`.
+Summary run_streaming(const std::string& params, std::vector<InputInfo> inputs, int runs,
+                      const std::function<void(Component&, int)>& feed, std::uint64_t* high_water = nullptr) {
+  for (auto& in : inputs) in = ordered(in);
+  auto worker = test::make("sink.metrics", params, "score");
+  auto aggregate = test::make("sink.metrics", params, "score");
+  worker->set_inputs(inputs);
+  aggregate->set_inputs(inputs);
+  Diagnostics diag;
+  if (high_water) *high_water = 0;
+  for (int r = 0; r < runs; ++r) {
+    worker->start_run({static_cast<std::uint64_t>(r), 7, &diag});
+    feed(*worker, r);
+    auto result = worker->end_run();
+    REQUIRE(result);
+    if (high_water)
+      *high_water = std::max(*high_water, static_cast<const metrics::MetricsRunResult&>(*result).pending_high_water);
+    aggregate->merge(*result);
+  }
+  Summary s;
+  aggregate->finish(s, {"score", "", static_cast<std::uint64_t>(runs)});
+  return s;
+}
+
+}  // namespace
+
+// The streaming path must give the stored path's summary and series to the bit, whatever the
+// truth's rate and delay, with and without series, for same_time all and last.
+TEST_CASE("streaming and stored paths give identical results") {
+  const std::vector<InputInfo> inputs{kFilter, kTruth, kConverted};
+  for (const char* params : {"{}", "{ series: false }", "{ same_time: last }", "{ skip_initial: 1 s, series: false }"})
+    for (int every : {1, 3})
+      for (int lag : {0, 4}) {
+        INFO(params << " truth every " << every << " steps, " << lag << " steps late");
+        auto feed = [&](Component& c, int r) { feed_run(c, r, 300, every, lag); };
+        const Summary stored = run_ensemble(params, inputs, 4, feed);
+        const Summary streamed = run_streaming(params, inputs, 4, feed);
+        REQUIRE(stored.find("position_rmse"));
+        REQUIRE(stored.find("measurement_position_rmse"));
+        check_same(stored, streamed);
+      }
+}
+
+// Only estimates whose truth has not yet passed them wait, scored in batches: at most a batch,
+// as many as the truth is late and the second estimate of a time stamp, however long the run.
+TEST_CASE("streaming keeps only the estimates waiting for truth") {
+  for (int lag : {0, 5}) {
+    std::uint64_t high_water = 0;
+    const Summary s = run_streaming("{ series: false }", {kFilter, kTruth}, 2,
+                                    [&](Component& c, int r) { feed_run(c, r, 20000, 1, lag); }, &high_water);
+    INFO("truth " << lag << " steps late");
+    CHECK(high_water >= 1);  // truth comes after the estimate of its own time
+    CHECK(high_water <= metrics::StreamScorer::kBatch + static_cast<std::uint64_t>(lag + 2));
+    CHECK(value(s, "estimates") > 39000);
+    CHECK(value(s, "unmatched_estimates") == 0);
+  }
+}
+
+// Truth after its estimate (as the engine delivers a sim step: the radar's branch first) is
+// matched, and an estimate truth never reaches is unmatched at the end of the run.
+TEST_CASE("streaming scores truth that arrives after its estimate") {
+  auto feed = [](Component& c, int) {
+    for (int k = 0; k < 3; ++k) {
+      c.on_estimate(estimate(k, state(k + 2, 0, 0)), 0);
+      c.on_truth(truth(k, Vec3(k, 0, 0)), 1);
+    }
+    c.on_estimate(estimate(5, state(5, 0, 0)), 0);  // after the truth's last sample
+  };
+  const Summary s = run_streaming("{}", {kFilter, kTruth}, 2, feed);
+  CHECK(value(s, "position_rmse") == Approx(2.0));
+  CHECK(value(s, "estimates") == 8);
+  CHECK(value(s, "unmatched_estimates") == 2);
+  check_same(s, run_ensemble("{}", {kFilter, kTruth}, 2, feed));
+}
+
+// Without truth and series (a recorded log) a run keeps sums only: the ensemble's ANIS is the
+// same mean, summed in another order (so equal to ~1e-15, not to the bit), and a run with other
+// time steps than the rest is told in a note.
+TEST_CASE("no truth and no series: streaming keeps run sums only") {
+  const std::vector<InputInfo> inputs{kFilter, kConverted};
+  auto feed = [](Component& c, int r) { feed_run(c, r, 2000, 0, 0); };
+  const Summary stored = run_ensemble("{ series: false }", inputs, 3, feed);
+  const Summary streamed = run_streaming("{ series: false }", inputs, 3, feed);
+  for (const char* name : {"anis", "mean_innovation_0", "mean_innovation_2"}) {
+    INFO(name);
+    CHECK(value(streamed, name) == Approx(value(stored, name)).epsilon(1e-12));
+  }
+  CHECK(value(streamed, "estimates") == value(stored, "estimates"));
+  CHECK(value(streamed, "steps") == value(stored, "steps"));
+  CHECK(streamed.find("anis")->band_lo == stored.find("anis")->band_lo);
+  CHECK(stored.notes == streamed.notes);
+  // One run: the same sums in the same order, to the bit.
+  check_same(run_ensemble("{ series: false }", inputs, 1, feed), run_streaming("{ series: false }", inputs, 1, feed));
+  // Runs of different lengths: a note, and steps is the longest run's.
+  const Summary uneven = run_streaming("{ series: false }", inputs, 2,
+                                       [](Component& c, int r) { feed_run(c, r, 100 + 50 * r, 0, 0); });
+  CHECK(has_note(uneven, "runs differ in their time steps"));
+  CHECK(value(uneven, "steps") == 148);
+}
+
+// Truth of several targets, and an id the single truth target does not have (matched to it
+// only if no second target comes, so it waits for the end of the run), give the stored
+// path's results too.
+TEST_CASE("streaming matches stored with several truth targets") {
+  for (int second : {-1, 0, 40}) {  // the second target's first step (-1: none)
+    for (std::uint32_t id : {0u, 1u, 7u}) {
+      INFO("second target from step " << second << ", estimates of target " << id);
+      auto feed = [&](Component& c, int r) {
+        Rng rng(50 + static_cast<std::uint64_t>(r));
+        for (int k = 0; k < 100; ++k) {
+          const double t = 0.5 * k;
+          Estimate e = estimate(t, state(10 * t + rng.normal(), rng.normal(), 0), random_covariance(rng));
+          e.target = id;
+          c.on_estimate(e, 0);
+          Truth a = truth(t, Vec3(10 * t, 0, 0), Vec3(10, 0, 0));
+          c.on_truth(a, 1);
+          if (second >= 0 && k >= second) {
+            Truth b = truth(t, Vec3(10 * t + 100, 0, 0), Vec3(10, 0, 0));
+            b.target = 1;
+            c.on_truth(b, 1);
+          }
+        }
+      };
+      std::uint64_t high_water = 0;
+      const Summary streamed = run_streaming("{}", {kFilter, kTruth}, 3, feed, &high_water);
+      check_same(run_ensemble("{}", {kFilter, kTruth}, 3, feed), streamed);
+      if (id == 0 || (id == 1 && second == 0)) CHECK(high_water <= metrics::StreamScorer::kBatch);
+    }
+  }
 }

@@ -1,0 +1,51 @@
+// Purpose: how one estimate's record is scored, shared by sink.metrics' stored path (end of run) and streaming path (as truth arrives), so both give the same bits.
+#pragma once
+
+#include "ensemble.hpp"
+#include "scoring/nees.hpp"
+
+#include <trackflow/items.hpp>
+
+#include <cmath>
+
+namespace trackflow::metrics {
+
+// What needs no truth: the record is scored, and an updated estimate carries its innovation.
+inline void score_innovation(EstimateRecord& rec, bool updated, double nis, const MeasVec& innovation) {
+  rec.scored = true;
+  const int m = static_cast<int>(innovation.size());
+  if (updated && m > 0 && std::isfinite(nis)) {
+    rec.nis_dof = m;
+    rec.nis = nis;
+    rec.innovation.head(m) = innovation;
+  }
+}
+
+// A matched estimate: its error and (when the covariance allows) NEES and position NEES, from one
+// factorisation of the covariance (nees.hpp).
+inline void score_error(EstimateRecord& rec, const Vec6& enu, const Mat6& covariance, const Vec6& truth,
+                        MetricsRunResult& r) {
+  rec.matched = true;
+  rec.error = enu - truth;
+  double terms[6];
+  if (covariance.allFinite() && nees_terms(covariance, rec.error, terms)) {
+    rec.nees_position = terms[0] + terms[1] + terms[2];
+    rec.nees = rec.nees_position + terms[3] + terms[4] + terms[5];
+    rec.has_nees = std::isfinite(rec.nees) && std::isfinite(rec.nees_position);
+  }
+  if (!rec.has_nees) ++r.not_positive_definite;
+}
+
+// A measurement inside the window: into the run's baseline sums (and its record, for the series).
+inline void add_measurement(MetricsRunResult& r, double time, bool matched, double sq, double tolerance,
+                            bool series) {
+  if (!matched) {
+    ++r.measurements_unmatched;
+    return;
+  }
+  r.measurement_sq_error += sq;
+  ++r.measurements_matched;
+  if (series) r.measurement_records.push_back({std::llround(time / tolerance), time, sq});
+}
+
+}  // namespace trackflow::metrics
