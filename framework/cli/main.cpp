@@ -302,6 +302,10 @@ void describe_params_text(std::ostream& os, const std::vector<ParamSpec>& ps, co
        << r.type << std::setw(static_cast<int>(wd + 2)) << r.def << r.doc << "\n";
 }
 
+// Said of a filter whose declaration has create_estimator (registry.hpp).
+constexpr const char* kEstimatorNote =
+    "Per-track estimator: yes (the same parameters make the estimator a tracker runs per track).";
+
 void describe(std::ostream& os, const RegisteredType& t, bool md) {
   const auto& d = t.decl;
   if (md) {
@@ -310,6 +314,7 @@ void describe(std::ostream& os, const RegisteredType& t, bool md) {
     os << "Inputs: " << kinds_text(d.accepts) << " (" << d.min_inputs << " to "
        << (d.max_inputs < 0 ? std::string("any") : std::to_string(d.max_inputs)) << "); outputs: " << kinds_text(d.produces)
        << ".\n\n";
+    if (d.create_estimator) os << kEstimatorNote << "\n\n";
     if (!d.params.empty()) {
       os << "| parameter | type [unit] | default | doc |\n|---|---|---|---|\n";
       describe_params_md(os, d.params);
@@ -321,7 +326,8 @@ void describe(std::ostream& os, const RegisteredType& t, bool md) {
   if (!d.doc.empty()) os << "\n" << d.doc << "\n";
   os << "\ninputs:  " << kinds_text(d.accepts) << " (" << d.min_inputs << " to "
      << (d.max_inputs < 0 ? std::string("any") : std::to_string(d.max_inputs)) << ")\noutputs: " << kinds_text(d.produces)
-     << "\n\nparameters (bare numbers are SI: m, s, rad; or write a unit: 3 mrad, 1.5 km, 40 Hz):\n";
+     << "\n" << (d.create_estimator ? std::string(kEstimatorNote) + "\n" : std::string())
+     << "\nparameters (bare numbers are SI: m, s, rad; or write a unit: 3 mrad, 1.5 km, 40 Hz):\n";
   describe_params_text(os, d.params, "  ");
 }
 
