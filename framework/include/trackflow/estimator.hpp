@@ -96,6 +96,8 @@ class Estimator {
   virtual StateLayout layout() const = 0;
   // The noise adapters may read and overwrite (noise.hpp), this track's own.
   virtual NoiseHandles noise() = 0;
+  // A copy of this track's estimator, state included (a tracker starts tracks from a prototype);
+  // it reports to the same TrackContext until bind() gives it its own.
   virtual std::unique_ptr<Estimator> clone() const = 0;
 
   // Optional: further checks of a valid measurement (throw DataError), names of values the
