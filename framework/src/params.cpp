@@ -1,4 +1,5 @@
 // Purpose: parameter declarations' builders and the typed getters of validated parameters.
+#include <trackflow/estimator.hpp>
 #include <trackflow/params.hpp>
 
 namespace trackflow {
@@ -103,7 +104,18 @@ const NestedComponent& Params::component(std::string_view n) const {
   return get(n, ParamType::Component).components.front();  // validation makes exactly one
 }
 const std::vector<NestedComponent>& Params::components(std::string_view n) const {
+  for (const auto& [name, v] : values_)
+    if (name == n && v.type == ParamType::Records) return v.components;  // a Records list or_components
   return get(n, ParamType::ComponentList).components;
+}
+
+std::unique_ptr<Estimator> NestedComponent::create_estimator() const {
+  if (!estimator_factory)
+    throw ConfigError("type '" + type + "' declares no per-track estimator, so it cannot be composed here", type_where,
+                      params.node());
+  std::unique_ptr<Estimator> e = estimator_factory(params);
+  if (!e) throw ConfigError("estimator factory of '" + type + "' returned nothing", type_where, params.node());
+  return e;
 }
 
 Vec3 Params::vec3(std::string_view n) const {

@@ -94,7 +94,9 @@ NestedComponent parse_component(const ParamSpec& s, const Value& v, const std::s
       rest.key_locs.erase(rest.key_locs.begin() + static_cast<std::ptrdiff_t>(i));
       break;
     }
-  return {decl->type, validate_params(decl->params, rest, node, v.loc, types), type->loc};
+  NestedComponent out{decl->type, validate_params(decl->params, rest, node, v.loc, types), type->loc, {}};
+  out.estimator_factory = decl->create_estimator;
+  return out;
 }
 
 ParamValue parse_value(const ParamSpec& s, const Value& v, const std::string& node, const ComponentTypes& types) {
@@ -162,8 +164,15 @@ ParamValue parse_value(const ParamSpec& s, const Value& v, const std::string& no
       for (const auto& item : v.items) {
         if (item.kind != Value::Kind::Map)
           throw ConfigError("each entry of '" + s.name + "' must be a map, got " + item.describe(), item.loc, node);
-        out.records.push_back(validate_params(s.fields, item, node, item.loc, types));
+        if (s.components_too && item.find("type"))
+          out.components.push_back(parse_component(s, item, node, types));
+        else
+          out.records.push_back(validate_params(s.fields, item, node, item.loc, types));
       }
+      if (!out.records.empty() && !out.components.empty())
+        throw ConfigError("parameter '" + s.name + "': give every entry as a record or every entry as a component {type: " +
+                              accepted_text(s) + ", <its parameters>}, not both",
+                          v.loc, node);
       break;
     }
     case ParamType::Component:
@@ -189,6 +198,8 @@ std::string describe_type(const ParamSpec& s) {
     case ParamType::Choice: return "choice {" + join(s.choices, "|") + "}";
     case ParamType::Component: return "component {type: " + accepted_text(s) + "}";
     case ParamType::ComponentList: return "list of components {type: " + accepted_text(s) + "}";
+    case ParamType::Records:
+      return s.components_too ? "list of records or of components {type: " + accepted_text(s) + "}" : "list of records";
     default: return to_string(s.type);
   }
 }

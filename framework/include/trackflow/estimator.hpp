@@ -107,6 +107,10 @@ class Estimator {
   virtual std::vector<std::string> annotation_names() const { return {}; }
   virtual void end_run(bool /*initialised*/) {}
   virtual void finish(Summary&) const {}
+  // Optional: replace the state and covariance (layout() order, sizes layout().dim), e.g. with an
+  // IMM's mixed start, keeping everything else (motion model, noise, initialisation). false: this
+  // estimator cannot take a state from outside (it cannot be a filter.imm mode); nothing changed.
+  virtual bool assign(const StateVec& /*x*/, const StateCov& /*P*/) { return false; }
 
   const MeasurementSpec& measurement_spec() const { return spec_; }
   void bind(TrackContext& track) { track_ = &track; }

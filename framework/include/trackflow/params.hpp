@@ -5,7 +5,9 @@
 #include <trackflow/items.hpp>
 #include <trackflow/units.hpp>
 
+#include <functional>
 #include <initializer_list>
+#include <memory>
 #include <limits>
 #include <string>
 #include <string_view>
@@ -41,6 +43,9 @@ struct ParamSpec {
   std::vector<std::string> choices;
   std::vector<int> choice_values;  // Choice: the enum value of each word (see choice<E>)
   std::vector<ParamSpec> fields;  // Records only
+  // Records only: an entry with a `type:` key is a nested component (of `kinds` and `type_prefix`,
+  // validated against that type's declaration) instead of a record; entries are all of one form.
+  bool components_too = false;
   double min = -std::numeric_limits<double>::infinity();  // SI, inclusive
   double max = std::numeric_limits<double>::infinity();
   int list_size = -1;             // RealList: exact length when >= 0
@@ -79,6 +84,13 @@ struct ParamSpec {
   // the plugin reads it as p.component(name) and may ask the host to create it.
   static ParamSpec component(std::string name, std::vector<ComponentKind> kinds, std::string doc);
   static ParamSpec component_list(std::string name, std::vector<ComponentKind> kinds, std::string doc);
+  // A Records list whose entries may instead all be nested components of `kinds`
+  // (p.records(name) then holds none and p.components(name) each entry).
+  ParamSpec or_components(std::vector<ComponentKind> k) && {
+    kinds = std::move(k);
+    components_too = true;
+    return std::move(*this);
+  }
   // Only types whose name starts with `prefix` ("filter.").
   ParamSpec with_prefix(std::string prefix) && { type_prefix = std::move(prefix); return std::move(*this); }
   ParamSpec def(std::string text) && { default_text = std::move(text); return std::move(*this); }
@@ -90,6 +102,7 @@ struct ParamSpec {
 
 class Params;
 struct NestedComponent;
+class Estimator;
 
 struct ParamValue {
   ParamType type = ParamType::Real;
@@ -132,7 +145,9 @@ class Params {
   Vec3 vec3(std::string_view name) const;                // RealList of size 3
   const std::vector<Params>& records(std::string_view name) const;
   const NestedComponent& component(std::string_view name) const;               // Component only
-  const std::vector<NestedComponent>& components(std::string_view name) const;  // ComponentList only
+  // ComponentList, or the component entries of a Records list declared or_components (empty when
+  // its entries are records).
+  const std::vector<NestedComponent>& components(std::string_view name) const;
   double real_or(std::string_view name, double fallback) const { return has(name) ? real(name) : fallback; }
 
   bool has(std::string_view name) const;    // a value exists (given or defaulted)
@@ -160,6 +175,14 @@ struct NestedComponent {
   std::string type;
   Params params;
   SourceLoc type_where;  // the `type:` value, for messages about the type itself
+  // The nested type's per-track estimator factory (its ComponentDecl::create_estimator), set by
+  // the host at validation; empty when the type declares none. Its code lives in that type's
+  // plugin, which the host keeps loaded while the pipeline that named it exists.
+  std::function<std::unique_ptr<Estimator>(const Params&)> estimator_factory;
+
+  // The nested type's estimator from `params`, for a component composed of estimators (filter.imm's
+  // modes). Throws ConfigError at the `type:` value when the type declares no estimator.
+  std::unique_ptr<Estimator> create_estimator() const;
 };
 
 }  // namespace trackflow

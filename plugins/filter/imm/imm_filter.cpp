@@ -55,6 +55,23 @@ struct ImmConfig {
   std::vector<double> transition, initial;
 };
 
+// Both forms: the noise adapters may replace (R only: each mode keeps its own process noise), the
+// published state (imm::publish), the annotations (the mode probabilities).
+NoiseHandles imm_noise(MeasCov& R) {
+  NoiseHandles h;
+  h.measurement = {&R, MeasurementSpace::Spherical};
+  return h;
+}
+StateLayout imm_layout(bool any_acceleration) {
+  return any_acceleration ? ConstantAcceleration::state_layout() : ConstantVelocity::state_layout();
+}
+template <class Name>
+std::vector<std::string> probability_names(int count, Name name) {
+  std::vector<std::string> names;
+  for (int j = 0; j < count; ++j) names.push_back("p_" + name(j));
+  return names;
+}
+
 // Blom & Bar-Shalom (1988) IMM, one cycle per measurement: mixing (predict), mode-matched EKF
 // updates, mode probabilities from the innovation likelihoods, and the combined estimate
 // (fill_estimate). The equations and the treatment of unequal state sizes: docs/filters.md.
@@ -69,23 +86,14 @@ class ImmEstimator final : public Estimator {
       modes_[j] = c.modes[static_cast<size_t>(j)];
       mu0_[j] = c.initial[static_cast<size_t>(j)];
       any_acceleration_ = any_acceleration_ || modes_[j].order == 3;
-      all_acceleration_ = all_acceleration_ && modes_[j].order == 3;
       for (int i = 0; i < count_; ++i) pi_[j * count_ + i] = c.transition[static_cast<size_t>(j * count_ + i)];
     }
   }
 
-  NoiseHandles noise() override {
-    NoiseHandles h;  // R only: each mode keeps its own process noise
-    h.measurement = {&R_, MeasurementSpace::Spherical};
-    return h;
-  }
-  StateLayout layout() const override {
-    return any_acceleration_ ? ConstantAcceleration::state_layout() : ConstantVelocity::state_layout();
-  }
+  NoiseHandles noise() override { return imm_noise(R_); }
+  StateLayout layout() const override { return imm_layout(any_acceleration_); }
   std::vector<std::string> annotation_names() const override {
-    std::vector<std::string> names;
-    for (int j = 0; j < count_; ++j) names.push_back("p_" + modes_[j].name);
-    return names;
+    return probability_names(count_, [&](int j) { return modes_[j].name; });
   }
 
  private:
@@ -158,8 +166,7 @@ class ImmEstimator final : public Estimator {
     const Eigen::Matrix<double, M, M> R = R_.template topLeftCorner<M, M>();
     double ll[kMaxModes];
     bool used[kMaxModes];
-    bool any = false, dropped = false;
-    double worst = std::numeric_limits<double>::infinity();
+    bool dropped = false;
     for (int j = 0; j < count_; ++j) {
       cartesian_filter::EkfOutcome outcome{};
       visit(modes_[j], [&](auto& s) {
@@ -170,46 +177,33 @@ class ImmEstimator final : public Estimator {
       ll[j] = used[j] ? imm::log_likelihood(M, innovation<M>(j).nis, innovation<M>(j).det_S)
                       : -std::numeric_limits<double>::infinity();
       if (!used[j]) count(kModeRefused);
-      if (used[j] && std::isfinite(ll[j])) {
-        any = true;
-        worst = std::min(worst, ll[j]);
-      }
     }
     if (dropped) count(kAzimuthDropped);
-    if (!any) {
-      std::copy(c_, c_ + count_, mu_);
+    if (!imm::floor_likelihoods(ll, used, count_)) {
+      for (int j = 0; j < count_; ++j) mu_[j] = c_[j];
       publish_probabilities();
       warn("no mode could use the measurement at t=" + std::to_string(m.time) +
            " s (predicted position at the sensor, or S not positive definite); measurement not used");
       return false;
     }
-    // A mode that could not update is neither favoured nor dropped: it gets the worst likelihood.
-    for (int j = 0; j < count_; ++j)
-      if (!used[j] || !std::isfinite(ll[j])) ll[j] = worst;
     imm::update_probabilities(c_, ll, count_, mu_);
     publish_probabilities();
     publish_innovation<M>(used);
     return true;
   }
 
-  // The measurement-prediction mixture: z^ = sum c_j z^_j, so nu = sum c_j nu_j and
-  // S = sum c_j (S_j + (nu_j - nu)(nu_j - nu)'), over the modes that updated (weights renormalised).
+  // The measurement-prediction mixture (imm::innovation_mixture) as the accepted innovation.
   template <int M>
   void publish_innovation(const bool* used) {
-    using VecM = Eigen::Matrix<double, M, 1>;
-    using MatM = Eigen::Matrix<double, M, M>;
-    double total = 0.0;
-    for (int j = 0; j < count_; ++j)
-      if (used[j]) total += c_[j];
-    VecM nu = VecM::Zero();
-    MatM S = MatM::Zero();
-    for (int j = 0; j < count_; ++j)
-      if (used[j] && total > 0.0) nu += (c_[j] / total) * innovation<M>(j).nu;
-    for (int j = 0; j < count_; ++j)
-      if (used[j] && total > 0.0) {
-        const VecM d = innovation<M>(j).nu - nu;
-        S += (c_[j] / total) * (innovation<M>(j).S + d * d.transpose());
-      }
+    const Eigen::Matrix<double, M, 1>* nu_j[kMaxModes];
+    const Eigen::Matrix<double, M, M>* S_j[kMaxModes];
+    for (int j = 0; j < count_; ++j) {
+      nu_j[j] = &innovation<M>(j).nu;
+      S_j[j] = &innovation<M>(j).S;
+    }
+    Eigen::Matrix<double, M, 1> nu;
+    Eigen::Matrix<double, M, M> S;
+    imm::innovation_mixture<M>(c_, used, count_, nu_j, S_j, nu, S);
     double nis = 0.0;
     if (!imm::quadratic_form<M>(S, nu, nis)) nis = 0.0;  // a mixture of PD matrices is PD: not reached
     accept_update<M>(nu, S, nis);
@@ -219,53 +213,10 @@ class ImmEstimator final : public Estimator {
     for (int j = 0; j < count_; ++j) annotate(j, mu_[j]);
   }
 
-  // The combined estimate, moment-matched on the common state. The acceleration of a mode
-  // without one is the probability-weighted acceleration of the modes that carry it.
+  // The combined estimate, moment-matched on the common state (imm::combine).
   void fill(Estimate& e) const override {
-    const imm::ModeView& v = view();
-    // Every mode mixed into the reference has its own acceleration, so the reference passed to
-    // that mixture is never read.
-    imm::VecC ref_x = imm::VecC::Zero();
-    imm::MatC ref_P = imm::MatC::Zero();
-    if (any_acceleration_ && !all_acceleration_) {
-      double wa[kMaxModes] = {}, total = 0.0;
-      for (int i = 0; i < count_; ++i)
-        if (modes_[i].order == 3) total += mu_[i];
-      for (int i = 0; i < count_; ++i)
-        if (modes_[i].order == 3) wa[i] = total > 0.0 ? mu_[i] / total : 1.0;
-      double sum = 0.0;
-      for (int i = 0; i < count_; ++i) sum += wa[i];
-      for (int i = 0; i < count_; ++i) wa[i] /= sum;
-      imm::mix(v, wa, ref_x, ref_P, x0_, P0_);
-      ref_x = x0_;
-      ref_P = P0_;
-    }
-    imm::mix(v, mu_, ref_x, ref_P, x0_, P0_);
-    const int n = any_acceleration_ ? 9 : 6;
-    e.state.resize(n);
-    e.covariance.resize(n, n);
-    int idx[6];
-    if (any_acceleration_) {
-      e.state.head<9>() = x0_;
-      e.covariance.topLeftCorner<9, 9>() = P0_;
-      for (int a = 0; a < 3; ++a) {
-        idx[a] = 3 * a;
-        idx[a + 3] = 3 * a + 1;
-      }
-    } else {
-      for (int i = 0; i < 6; ++i) {
-        e.state(i) = x0_(imm::common_index<2>(i));
-        for (int k = 0; k < 6; ++k) e.covariance(i, k) = P0_(imm::common_index<2>(i), imm::common_index<2>(k));
-      }
-      for (int a = 0; a < 3; ++a) {
-        idx[a] = 2 * a;
-        idx[a + 3] = 2 * a + 1;
-      }
-    }
-    for (int i = 0; i < 6; ++i) {
-      e.enu(i) = e.state(idx[i]);
-      for (int k = 0; k < 6; ++k) e.enu_covariance(i, k) = e.covariance(idx[i], idx[k]);
-    }
+    imm::combine(view(), mu_, x0_, P0_);
+    imm::publish(x0_, P0_, any_acceleration_, e);
   }
 
   void scale_covariance(double k) override {
@@ -287,7 +238,7 @@ class ImmEstimator final : public Estimator {
 
   int count_ = 0;
   std::array<Mode, kMaxModes> modes_;
-  bool any_acceleration_ = false, all_acceleration_ = true, mixed_ = false;
+  bool any_acceleration_ = false, mixed_ = false;
   double pi_[kMaxModes * kMaxModes] = {};  // row i: from mode i
   double mu0_[kMaxModes] = {}, mu_[kMaxModes] = {}, c_[kMaxModes] = {};
   double w_[kMaxModes][kMaxModes] = {};  // w_[j][i]: weight of mode i in mode j's mixed start
@@ -301,6 +252,371 @@ class ImmEstimator final : public Estimator {
   mutable imm::VecC x0_ = imm::VecC::Zero();
   mutable imm::MatC P0_ = imm::MatC::Zero();
 };
+
+// --- The component form: modes: [{type: filter.ekf, ...}, {type: filter.ukf, ...}] -----------------
+
+// The common state's component names, in its order (motion.hpp's constant-acceleration layout).
+constexpr const char* kCommonNames[imm::kC] = {"x", "vx", "ax", "y", "vy", "ay", "z", "vz", "az"};
+
+// One mode given as a nested component: its estimator (created by the host from the nested
+// type's create_estimator), where each of its state components lies in the common state.
+struct EstimatorMode {
+  std::string name;
+  std::shared_ptr<const Estimator> prototype;  // cloned per IMM estimator
+  int dim = 0;
+  int common[kMaxStateDim] = {};  // common-state index of the mode's state component r
+  bool has_acceleration = false;
+};
+
+struct ComponentImmConfig {
+  RangeRateUse range_rate = RangeRateUse::Auto;
+  bool tilted_sensors = true;
+  std::vector<EstimatorMode> modes;
+  std::vector<double> transition, initial;
+};
+
+// A mode's track: its warnings are collected and passed on (named) by the IMM, its counts and
+// annotations dropped; `estimate` receives the innovation of its accepted update.
+struct ModeTrack final : TrackContext {
+  void warn(const std::string& message) override { warnings.push_back(message); }
+  void count(int) override {}
+  void annotate(int, double) override {}
+  std::vector<std::string> warnings;
+};
+
+// An owned mode estimator that a copy clones.
+struct OwnedEstimator {
+  std::unique_ptr<Estimator> e;
+  OwnedEstimator() = default;
+  explicit OwnedEstimator(std::unique_ptr<Estimator> p) : e(std::move(p)) {}
+  OwnedEstimator(const OwnedEstimator& o) : e(o.e ? o.e->clone() : nullptr) {}
+  OwnedEstimator& operator=(const OwnedEstimator& o) {
+    if (this != &o) e = o.e ? o.e->clone() : nullptr;
+    return *this;
+  }
+};
+
+// The same IMM cycle as ImmEstimator (imm_mixing.hpp's mixing, combination, likelihoods) over
+// modes that are estimators of any type taking a state (Estimator::assign) on a Cartesian layout:
+// a mode's state and covariance come from its fill() and go back, mixed, through assign(); its
+// likelihood from the innovation of its own update (nu, S, NIS through its ModeTrack).
+class ComponentImmEstimator final : public Estimator {
+ public:
+  explicit ComponentImmEstimator(const ComponentImmConfig& c)
+      : Estimator(MeasurementSpec{Frame::Spherical, c.range_rate, {"mode_updates_refused"}, c.tilted_sensors}) {
+    count_ = static_cast<int>(c.modes.size());
+    for (int j = 0; j < count_; ++j) {
+      const EstimatorMode& m = c.modes[static_cast<size_t>(j)];
+      st_.names[j] = m.name;
+      st_.dim[j] = m.dim;
+      for (int r = 0; r < m.dim && r < kMaxStateDim; ++r) st_.common[j][r] = m.common[r];
+      st_.has_acceleration[j] = m.has_acceleration;
+      any_acceleration_ = any_acceleration_ || m.has_acceleration;
+      st_.modes[j] = OwnedEstimator(m.prototype->clone());
+      st_.mu0[j] = c.initial[static_cast<size_t>(j)];
+      for (int i = 0; i < count_; ++i) st_.pi[j * count_ + i] = c.transition[static_cast<size_t>(j * count_ + i)];
+    }
+    rebind();
+  }
+  ComponentImmEstimator(const ComponentImmEstimator& o)
+      : Estimator(o), count_(o.count_), any_acceleration_(o.any_acceleration_), st_(o.st_) {
+    rebind();
+  }
+  ComponentImmEstimator& operator=(const ComponentImmEstimator&) = delete;
+
+  NoiseHandles noise() override { return imm_noise(R_); }
+  StateLayout layout() const override { return imm_layout(any_acceleration_); }
+  std::vector<std::string> annotation_names() const override {
+    return probability_names(count_, [&](int j) { return st_.names[j]; });
+  }
+  void check(const Measurement& m) override {
+    for (int j = 0; j < count_; ++j) mode(j).check(m);
+  }
+  void end_run(bool initialised) override {
+    for (int j = 0; j < count_; ++j) {
+      mode(j).end_run(initialised);
+      pass_warnings(j);
+    }
+  }
+
+ private:
+  enum Counter { kModeRefused };
+
+  Estimator& mode(int j) { return *st_.modes[j].e; }
+  const Estimator& mode(int j) const { return *st_.modes[j].e; }
+  void rebind() {
+    for (int j = 0; j < count_; ++j) {
+      st_.tracks[j].estimate = &st_.outcome[j];
+      mode(j).bind(st_.tracks[j]);
+    }
+  }
+  // Before a call into mode j: the time, the measurement noise, a fresh innovation.
+  void enter(int j) {
+    st_.tracks[j].time = time();
+    st_.outcome[j].updated = false;
+    mode(j).measurement_noise() = R_;
+  }
+  void pass_warnings(int j) {
+    for (const std::string& w : st_.tracks[j].warnings) warn("mode '" + st_.names[j] + "': " + w);
+    st_.tracks[j].warnings.clear();
+  }
+
+  bool reset() override {
+    bool initialised = true;
+    for (int j = 0; j < count_; ++j) {
+      st_.tracks[j].who = who() + " mode '" + st_.names[j] + "'";
+      enter(j);
+      initialised = mode(j).reset() && initialised;
+      pass_warnings(j);
+    }
+    for (int j = 0; j < count_; ++j) st_.mu[j] = st_.mu0[j];
+    mixed_ = false;
+    publish_probabilities();
+    return initialised;
+  }
+
+  // Every mode initiates from the same measurements; the track starts when all have.
+  bool initiate(const Measurement& m, int dim) override {
+    bool formed = true;
+    for (int j = 0; j < count_; ++j) {
+      enter(j);
+      formed = mode(j).initiate(m, dim) && formed;
+      pass_warnings(j);
+    }
+    publish_probabilities();
+    return formed;
+  }
+
+  // The modes on the common state, from their fill().
+  const imm::ModeView& view() const {
+    view_.count = count_;
+    for (int j = 0; j < count_; ++j) {
+      Estimate& e = scratch_[j];
+      mode(j).fill(e);
+      imm::CommonEstimate& c = common_[j];
+      c.x.setZero();
+      c.P.setZero();
+      const int n = st_.dim[j];
+      for (int r = 0; r < n; ++r) {
+        c.x(st_.common[j][r]) = e.state(r);
+        for (int k = 0; k < n; ++k) c.P(st_.common[j][r], st_.common[j][k]) = e.covariance(r, k);
+      }
+      c.has_acceleration = st_.has_acceleration[j];
+      view_.x[j] = &c.x;
+      view_.P[j] = &c.P;
+      view_.has_acceleration[j] = c.has_acceleration;
+    }
+    return view_;
+  }
+
+  // Interaction (mixing) on the common state, each mode's mixed start assigned, then its own
+  // prediction. All mixed starts are formed before any mode is overwritten.
+  void predict(double T) override {
+    imm::mixing_weights(st_.pi, st_.mu, count_, st_.c, st_.w);
+    const imm::ModeView& v = view();
+    for (int j = 0; j < count_; ++j) imm::mix(v, st_.w[j], *v.x[j], *v.P[j], st_.x0s[j], st_.P0s[j]);
+    for (int j = 0; j < count_; ++j) {
+      const int n = st_.dim[j];
+      StateVec x(n);
+      StateCov P(n, n);
+      for (int r = 0; r < n; ++r) {
+        x(r) = st_.x0s[j](st_.common[j][r]);
+        for (int k = 0; k < n; ++k) P(r, k) = st_.P0s[j](st_.common[j][r], st_.common[j][k]);
+      }
+      enter(j);
+      mode(j).assign(x, P);  // checked at configuration
+      mode(j).predict(T);
+      pass_warnings(j);
+    }
+    mixed_ = true;
+  }
+
+  bool predict_measurement(const SensorFrame& s, const MeasCov& R, PredictedMeasurement& p) const override {
+    return predicted_by_update<ComponentImmEstimator>(s, R, p);
+  }
+  std::unique_ptr<Estimator> clone() const override { return std::make_unique<ComponentImmEstimator>(*this); }
+
+  bool update(const Measurement& m, int dim) override {
+    if (!mixed_)  // no time elapsed: no transition
+      for (int j = 0; j < count_; ++j) st_.c[j] = st_.mu[j];
+    mixed_ = false;
+    double ll[kMaxModes];
+    bool used[kMaxModes];
+    for (int j = 0; j < count_; ++j) {
+      enter(j);
+      const Estimate& out = st_.outcome[j];
+      used[j] = mode(j).update(m, dim) && out.updated && out.innovation.size() == dim;
+      pass_warnings(j);
+      ll[j] = -std::numeric_limits<double>::infinity();
+      if (used[j]) {
+        PredictedMeasurement pm;
+        pm.S = out.innovation_covariance;
+        set_log_det(pm);
+        ll[j] = imm::log_likelihood_from_log_det(dim, out.nis, pm.log_det_S);
+      } else {
+        count(kModeRefused);
+      }
+    }
+    if (!imm::floor_likelihoods(ll, used, count_)) {
+      for (int j = 0; j < count_; ++j) st_.mu[j] = st_.c[j];
+      publish_probabilities();
+      warn("no mode could use the measurement at t=" + std::to_string(m.time) + " s; measurement not used");
+      return false;
+    }
+    imm::update_probabilities(st_.c, ll, count_, st_.mu);
+    publish_probabilities();
+    if (dim == 4)
+      publish_innovation<4>(used);
+    else
+      publish_innovation<3>(used);
+    return true;
+  }
+
+  template <int M>
+  void publish_innovation(const bool* used) {
+    Eigen::Matrix<double, M, 1> nus[kMaxModes];
+    Eigen::Matrix<double, M, M> Ss[kMaxModes];
+    const Eigen::Matrix<double, M, 1>* nu_j[kMaxModes];
+    const Eigen::Matrix<double, M, M>* S_j[kMaxModes];
+    for (int j = 0; j < count_; ++j) {
+      if (used[j]) {
+        nus[j] = st_.outcome[j].innovation.template head<M>();
+        Ss[j] = st_.outcome[j].innovation_covariance.template topLeftCorner<M, M>();
+      } else {
+        nus[j].setZero();
+        Ss[j].setZero();
+      }
+      nu_j[j] = &nus[j];
+      S_j[j] = &Ss[j];
+    }
+    Eigen::Matrix<double, M, 1> nu;
+    Eigen::Matrix<double, M, M> S;
+    imm::innovation_mixture<M>(st_.c, used, count_, nu_j, S_j, nu, S);
+    double nis = 0.0;
+    if (!imm::quadratic_form<M>(S, nu, nis)) nis = 0.0;  // a mixture of PD matrices is PD
+    accept_update<M>(nu, S, nis);
+  }
+
+  void publish_probabilities() {
+    for (int j = 0; j < count_; ++j) annotate(j, st_.mu[j]);
+  }
+
+  void fill(Estimate& e) const override {
+    imm::combine(view(), st_.mu, x0_, P0_);
+    imm::publish(x0_, P0_, any_acceleration_, e);
+  }
+
+  void scale_covariance(double k) override {
+    for (int j = 0; j < count_; ++j) mode(j).scale_covariance(k);
+  }
+
+  int count_ = 0;
+  bool any_acceleration_ = false, mixed_ = false;
+  // Everything a copy takes as it is (the modes cloned; rebind() points them at the copy's tracks).
+  struct State {
+    std::string names[kMaxModes];
+    int dim[kMaxModes] = {};
+    int common[kMaxModes][kMaxStateDim] = {};
+    bool has_acceleration[kMaxModes] = {};
+    OwnedEstimator modes[kMaxModes];
+    ModeTrack tracks[kMaxModes];
+    Estimate outcome[kMaxModes];  // each mode's accepted innovation
+    double pi[kMaxModes * kMaxModes] = {};  // row i: from mode i
+    double mu0[kMaxModes] = {}, mu[kMaxModes] = {}, c[kMaxModes] = {};
+    double w[kMaxModes][kMaxModes] = {};
+    imm::VecC x0s[kMaxModes];  // mixed starts
+    imm::MatC P0s[kMaxModes];
+  } st_;
+  // Scratch (fill is const: what it forms is no state of the filter).
+  mutable Estimate scratch_[kMaxModes];
+  mutable imm::CommonEstimate common_[kMaxModes];
+  mutable imm::ModeView view_;
+  mutable imm::VecC x0_ = imm::VecC::Zero();
+  mutable imm::MatC P0_ = imm::MatC::Zero();
+};
+
+const char* range_rate_word(RangeRateUse r) {
+  switch (r) {
+    case RangeRateUse::Auto: return "auto";
+    case RangeRateUse::Use: return "use";
+    case RangeRateUse::Ignore: return "ignore";
+  }
+  return "?";
+}
+
+// The mode name in the annotations: <type without "filter.">_<cv|ca|singer> when the type has a
+// motion choice, else the short type; on a clash <index>_<short type>.
+std::string component_mode_name(const NestedComponent& nc, int index, const std::vector<EstimatorMode>& before) {
+  const std::string shortname = nc.type.rfind("filter.", 0) == 0 ? nc.type.substr(7) : nc.type;
+  std::string name = shortname;
+  if (nc.params.has("motion")) {
+    const std::string& w = nc.params.choice_word("motion");
+    name += "_" + std::string(w == "constant_velocity" ? "cv" : w == "constant_acceleration" ? "ca" : w);
+  }
+  for (const EstimatorMode& m : before)
+    if (m.name == name) return std::to_string(index + 1) + "_" + shortname;
+  return name;
+}
+
+// Each nested mode's estimator, checked to be one an IMM can mix: spherical measurements with the
+// same range-rate use as the others, a Cartesian position/velocity(/acceleration) layout, assign().
+ComponentImmConfig make_component_config(const Params& p) {
+  ComponentImmConfig c;
+  const std::vector<NestedComponent>& nested = p.components("modes");
+  if (p.given("zenith"))
+    throw p.error("zenith", "with modes given as components, set zenith in each mode (filter.ekf, filter.ukf take it)");
+  for (size_t k = 0; k < nested.size(); ++k) {
+    const NestedComponent& nc = nested[k];
+    const std::string label = "mode " + std::to_string(k + 1) + " (" + nc.type + ")";
+    auto refuse = [&](const std::string& why) { return ConfigError(label + ": " + why, nc.type_where, p.node()); };
+    std::unique_ptr<Estimator> e = nc.create_estimator();
+    const MeasurementSpec& spec = e->measurement_spec();
+    if (spec.frame != Frame::Spherical)
+      throw refuse("it measures in another frame; an IMM's modes take spherical [r, az, el(, rdot)] measurements");
+    if (k == 0) {
+      c.range_rate = spec.range_rate;
+    } else if (spec.range_rate != c.range_rate) {
+      throw ConfigError(label + ": range_rate " + range_rate_word(spec.range_rate) + ", but mode 1 has " +
+                            range_rate_word(c.range_rate) + "; every mode must accept the same measurements",
+                        nc.params.given("range_rate") ? nc.params.where("range_rate") : nc.type_where, p.node());
+    }
+    c.tilted_sensors = c.tilted_sensors && spec.tilted_sensors;
+    EstimatorMode m;
+    const StateLayout L = e->layout();
+    m.dim = L.dim;
+    int found[imm::kC];
+    std::fill(found, found + imm::kC, -1);
+    for (int r = 0; r < L.dim; ++r) {
+      int at = -1;
+      for (int i = 0; i < imm::kC; ++i)
+        if (L.components[r].name && std::string(L.components[r].name) == kCommonNames[i]) at = i;
+      if (at < 0 || found[at] >= 0)
+        throw refuse(std::string("its state component '") + (L.components[r].name ? L.components[r].name : "?") +
+                     "' is not one of the common Cartesian state [x vx ax y vy ay z vz az]");
+      found[at] = r;
+      m.common[r] = at;
+    }
+    int accelerations = 0;
+    for (int i = 0; i < imm::kC; ++i) {
+      if (!imm::is_acceleration(i) && found[i] < 0)
+        throw refuse(std::string("its state has no '") + kCommonNames[i] + "'; an IMM mode needs the ENU position and velocity");
+      if (imm::is_acceleration(i) && found[i] >= 0) ++accelerations;
+    }
+    if (accelerations != 0 && accelerations != 3) throw refuse("its state has acceleration on some axes only");
+    m.has_acceleration = accelerations == 3;
+    // A probe: the estimator must take a mixed start.
+    std::unique_ptr<Estimator> probe = e->clone();
+    if (!probe->assign(StateVec::Zero(m.dim), StateCov::Identity(m.dim, m.dim)))
+      throw refuse("'" + nc.type + "' cannot be an IMM mode: its estimator does not take a mixed state (Estimator::assign)");
+    m.name = component_mode_name(nc, static_cast<int>(k), c.modes);
+    m.prototype = std::shared_ptr<const Estimator>(std::move(e));
+    c.modes.push_back(std::move(m));
+  }
+  if (p.given("range_rate") && p.choice<RangeRateUse>("range_rate") != c.range_rate)
+    throw p.error("range_rate", std::string("the modes use range_rate ") + range_rate_word(c.range_rate) +
+                                    "; with modes given as components, set it in each mode");
+  return c;
+}
 
 std::vector<ParamSpec> mode_fields() {
   std::vector<ParamSpec> f = {ParamSpec::string("name", "mode name in the annotations (p_<name>); default cv, ca or singer")};
@@ -318,16 +634,37 @@ const char* default_name(Settings::Motion m) {
   return "mode";
 }
 
-// The estimator of one track from the node's parameters (the node and a tracker take it alike).
+// The transition matrix and the initial mode probabilities of n modes (both forms).
+void read_probabilities(const Params& p, int n, std::vector<double>& transition, std::vector<double>& initial) {
+  transition = p.reals("transition");
+  if (std::string why = imm::check_transition(transition, n); !why.empty()) throw p.error("transition", why);
+  if (p.has("initial_probabilities")) {
+    initial = p.reals("initial_probabilities");
+    double sum = 0.0;
+    for (double v : initial) sum += v;
+    if (static_cast<int>(initial.size()) != n || std::fabs(sum - 1.0) > 1e-9)
+      throw p.error("initial_probabilities", "give one probability per mode (" + std::to_string(n) +
+                                                 "), summing to 1 (they sum to " + std::to_string(sum) + ")");
+    for (double v : initial)
+      if (!(v >= 0.0)) throw p.error("initial_probabilities", "probabilities cannot be negative");
+  } else {
+    initial.assign(static_cast<size_t>(n), 1.0 / n);
+  }
+}
+
+void check_mode_count(const Params& p, size_t n) {
+  if (n < 2 || n > static_cast<size_t>(kMaxModes))
+    throw p.error("modes", "an IMM takes 2 to " + std::to_string(kMaxModes) + " modes (got " + std::to_string(n) + ")");
+}
+
+// The estimator of one track from the node's parameters, record form (the node and a tracker take it alike).
 ImmEstimator make_estimator(const Params& p) {
   ImmConfig c;
   c.node = p.node();
   c.range_rate = p.choice<RangeRateUse>("range_rate");
   const auto zenith = p.choice<Settings::Zenith>("zenith");
   const std::vector<Params>& records = p.records("modes");
-  if (records.size() < 2 || records.size() > static_cast<size_t>(kMaxModes))
-    throw p.error("modes", "an IMM takes 2 to " + std::to_string(kMaxModes) + " modes (got " +
-                               std::to_string(records.size()) + ")");
+  check_mode_count(p, records.size());
   for (const Params& r : records) {
     Settings s;
     s.type = "filter.imm";
@@ -353,39 +690,42 @@ ImmEstimator make_estimator(const Params& p) {
       m.ca = CartesianRadarState<3>(s);
     c.modes.push_back(std::move(m));
   }
-  const int n = static_cast<int>(c.modes.size());
-  c.transition = p.reals("transition");
-  if (std::string why = imm::check_transition(c.transition, n); !why.empty()) throw p.error("transition", why);
-  if (p.has("initial_probabilities")) {
-    c.initial = p.reals("initial_probabilities");
-    double sum = 0.0;
-    for (double v : c.initial) sum += v;
-    if (static_cast<int>(c.initial.size()) != n || std::fabs(sum - 1.0) > 1e-9)
-      throw p.error("initial_probabilities", "give one probability per mode (" + std::to_string(n) +
-                                                 "), summing to 1 (they sum to " + std::to_string(sum) + ")");
-    for (double v : c.initial)
-      if (!(v >= 0.0)) throw p.error("initial_probabilities", "probabilities cannot be negative");
-  } else {
-    c.initial.assign(static_cast<size_t>(n), 1.0 / n);
-  }
+  read_probabilities(p, static_cast<int>(c.modes.size()), c.transition, c.initial);
   return ImmEstimator(c);
 }
 
+// The component form's estimator: modes created by the host from their nested declarations.
+ComponentImmEstimator make_component_estimator(const Params& p) {
+  check_mode_count(p, p.components("modes").size());
+  ComponentImmConfig c = make_component_config(p);
+  read_probabilities(p, static_cast<int>(c.modes.size()), c.transition, c.initial);
+  return ComponentImmEstimator(c);
+}
+
+bool component_form(const Params& p) { return !p.components("modes").empty(); }
+
 std::unique_ptr<Component> create(const Params& p) {
+  if (component_form(p)) return make_single_track_filter("filter.imm", p.node(), make_component_estimator(p));
   return make_single_track_filter("filter.imm", p.node(), make_estimator(p));
 }
 
-std::unique_ptr<Estimator> create_estimator(const Params& p) { return std::make_unique<ImmEstimator>(make_estimator(p)); }
+std::unique_ptr<Estimator> create_estimator(const Params& p) {
+  if (component_form(p)) return std::make_unique<ComponentImmEstimator>(make_component_estimator(p));
+  return std::make_unique<ImmEstimator>(make_estimator(p));
+}
 
 void register_components(Registrar& r) {
   ComponentDecl d;
   d.type = "filter.imm";
   d.kind = ComponentKind::Filter;
-  d.summary = "Interacting multiple model filter: 2-4 Cartesian EKF modes (CV, CA, Singer) on spherical [r, az, el(, "
-              "rdot)] measurements, mode probabilities as annotations";
+  d.summary = "Interacting multiple model filter: 2-4 Cartesian EKF modes (CV, CA, Singer) or nested filters "
+              "(filter.ekf, filter.ukf) on spherical [r, az, el(, rdot)] measurements, mode probabilities as annotations";
   d.doc =
       "Blom & Bar-Shalom (1988) IMM. Each mode is filter.ekf's Cartesian ENU EKF with its own motion model and "
-      "noise (modes: a list of records with filter.ekf's motion parameters). Per measurement: mixing of the mode "
+      "noise (modes: a list of records with filter.ekf's motion parameters), or each mode is a nested filter "
+      "component ({type: filter.ekf or filter.ukf, <its parameters>}, validated against that type's declaration) "
+      "whose per-track estimator takes the mixed state (Estimator::assign); all modes must accept the same "
+      "measurements (spherical, the same range_rate). Per measurement: mixing of the mode "
       "estimates with the Markov transition matrix (transition: row-major, row i = the probabilities of going from "
       "mode i to each mode; rows sum to 1) on the common state [x vx ax y vy ay z vz az]; a mode without "
       "acceleration (CV) borrows the receiving mode's acceleration, uncorrelated (unbiased mixing, Granstrom, "
@@ -398,7 +738,14 @@ void register_components(Registrar& r) {
   d.produces = mask(ItemKind::Estimate);
   d.accepts_frames = mask(Frame::Spherical);
   d.params = {
-      ParamSpec::records("modes", mode_fields(), "the mode filters (2 to 4): motion model and its noise each").req(),
+      ParamSpec::records("modes", mode_fields(),
+                         "the mode filters (2 to 4): records of filter.ekf's motion model and noise each, or "
+                         "components {type: filter.ekf or filter.ukf, <its parameters>} (any filter whose estimator "
+                         "takes a mixed Cartesian state); the annotation of a component mode is p_<type>_<motion>, "
+                         "e.g. p_ukf_ca (p_<index>_<type> on a clash)")
+          .or_components({ComponentKind::Filter})
+          .with_prefix("filter.")
+          .req(),
       ParamSpec::real_list("transition", dim::none,
                            "Markov transition matrix, row-major (modes x modes): row i = P(next mode | mode i), rows "
                            "sum to 1")
@@ -407,6 +754,8 @@ void register_components(Registrar& r) {
       range_rate_param(),
       cartesian_filter::zenith_param(),
   };
+  d.params[d.params.size() - 2].doc += " (component modes: set in each mode; given here, it must match theirs)";
+  d.params.back().doc += " (record form; component modes take their own)";
   d.create = create;
   d.create_estimator = create_estimator;
   r.add(std::move(d));

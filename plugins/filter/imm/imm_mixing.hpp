@@ -129,6 +129,103 @@ inline void mix(const CommonEstimate* modes, const double* w, int count, const V
   mix(v, w, ref_x, ref_P, x, P);
 }
 
+// The combined estimate of the modes with probabilities mu, moment-matched on the common state.
+// The acceleration of a mode without one is the probability-weighted acceleration of the modes
+// that carry it (every mode mixed into that reference has its own acceleration, so the reference
+// passed to that mixture is never read).
+inline void combine(const ModeView& v, const double* mu, VecC& x0, MatC& P0) {
+  bool any_acceleration = false, all_acceleration = true;
+  for (int i = 0; i < v.count; ++i) {
+    any_acceleration = any_acceleration || v.has_acceleration[i];
+    all_acceleration = all_acceleration && v.has_acceleration[i];
+  }
+  VecC ref_x = VecC::Zero();
+  MatC ref_P = MatC::Zero();
+  if (any_acceleration && !all_acceleration) {
+    double wa[kMaxModes] = {}, total = 0.0;
+    for (int i = 0; i < v.count; ++i)
+      if (v.has_acceleration[i]) total += mu[i];
+    for (int i = 0; i < v.count; ++i)
+      if (v.has_acceleration[i]) wa[i] = total > 0.0 ? mu[i] / total : 1.0;
+    double sum = 0.0;
+    for (int i = 0; i < v.count; ++i) sum += wa[i];
+    for (int i = 0; i < v.count; ++i) wa[i] /= sum;
+    mix(v, wa, ref_x, ref_P, x0, P0);
+    ref_x = x0;
+    ref_P = P0;
+  }
+  mix(v, mu, ref_x, ref_P, x0, P0);
+}
+
+// The combined estimate (combine) into e: the 9 common states when any mode has acceleration,
+// otherwise the constant-velocity 6 [x vx y vy z vz]; and the ENU position/velocity block.
+template <class Estimate>
+void publish(const VecC& x0, const MatC& P0, bool any_acceleration, Estimate& e) {
+  const int n = any_acceleration ? 9 : 6;
+  e.state.resize(n);
+  e.covariance.resize(n, n);
+  int idx[6];
+  if (any_acceleration) {
+    e.state.template head<9>() = x0;
+    e.covariance.template topLeftCorner<9, 9>() = P0;
+    for (int a = 0; a < 3; ++a) {
+      idx[a] = 3 * a;
+      idx[a + 3] = 3 * a + 1;
+    }
+  } else {
+    for (int i = 0; i < 6; ++i) {
+      e.state(i) = x0(common_index<2>(i));
+      for (int k = 0; k < 6; ++k) e.covariance(i, k) = P0(common_index<2>(i), common_index<2>(k));
+    }
+    for (int a = 0; a < 3; ++a) {
+      idx[a] = 2 * a;
+      idx[a + 3] = 2 * a + 1;
+    }
+  }
+  for (int i = 0; i < 6; ++i) {
+    e.enu(i) = e.state(idx[i]);
+    for (int k = 0; k < 6; ++k) e.enu_covariance(i, k) = e.covariance(idx[i], idx[k]);
+  }
+}
+
+// The measurement-prediction mixture: z^ = sum c_j z^_j, so nu = sum c_j nu_j and
+// S = sum c_j (S_j + (nu_j - nu)(nu_j - nu)'), over the modes that updated (weights renormalised).
+template <int M>
+void innovation_mixture(const double* c, const bool* used, int count, const Eigen::Matrix<double, M, 1>* const* nu_j,
+                        const Eigen::Matrix<double, M, M>* const* S_j, Eigen::Matrix<double, M, 1>& nu,
+                        Eigen::Matrix<double, M, M>& S) {
+  using VecM = Eigen::Matrix<double, M, 1>;
+  double total = 0.0;
+  for (int j = 0; j < count; ++j)
+    if (used[j]) total += c[j];
+  nu.setZero();
+  S.setZero();
+  for (int j = 0; j < count; ++j)
+    if (used[j] && total > 0.0) nu += (c[j] / total) * *nu_j[j];
+  for (int j = 0; j < count; ++j)
+    if (used[j] && total > 0.0) {
+      const VecM d = *nu_j[j] - nu;
+      S += (c[j] / total) * (*S_j[j] + d * d.transpose());
+    }
+}
+
+// A mode that could not update (used false, or a likelihood that is not finite) is neither
+// favoured nor dropped: it gets the worst likelihood of the modes that did. false (ll unchanged)
+// when no mode did.
+inline bool floor_likelihoods(double* ll, const bool* used, int count) {
+  bool any = false;
+  double worst = std::numeric_limits<double>::infinity();
+  for (int j = 0; j < count; ++j)
+    if (used[j] && std::isfinite(ll[j])) {
+      any = true;
+      worst = std::min(worst, ll[j]);
+    }
+  if (!any) return false;
+  for (int j = 0; j < count; ++j)
+    if (!used[j] || !std::isfinite(ll[j])) ll[j] = worst;
+  return true;
+}
+
 // Transition matrix (row-major, rows "from", columns "to"): count x count, entries in [0, 1],
 // each row summing to 1 within 1e-9. Returns why not, or empty.
 inline std::string check_transition(const std::vector<double>& pi, int count) {
@@ -167,6 +264,12 @@ inline double log_likelihood(int M, double nis, double det_S) {
   if (!(det_S > 0.0)) return -std::numeric_limits<double>::infinity();
   constexpr double kLog2Pi = 1.8378770664093454836;
   return -0.5 * (nis + std::log(det_S) + M * kLog2Pi);
+}
+// The same from ln det S (PredictedMeasurement::log_det_S, set_log_det). -inf unless it is finite.
+inline double log_likelihood_from_log_det(int M, double nis, double log_det_S) {
+  if (!std::isfinite(log_det_S) || !std::isfinite(nis)) return -std::numeric_limits<double>::infinity();
+  constexpr double kLog2Pi = 1.8378770664093454836;
+  return -0.5 * (nis + log_det_S + M * kLog2Pi);
 }
 
 // nu' S^-1 nu for a symmetric positive definite M x M S (Cholesky, unrolled for M <= 4); false

@@ -73,6 +73,12 @@ class CartesianRadarEstimator : public Estimator, protected CartesianRadarState<
   void predict(double T) override { this->predict_state(T, same_interval(T, this->last_interval())); }
   bool initiate(const Measurement& m, int) override { return this->add_point(m, R_); }
   void fill(Estimate& e) const override { this->fill_state(e); }
+  bool assign(const StateVec& x, const StateCov& P) override {
+    if (x.size() != N || P.rows() != N || P.cols() != N) return false;
+    x_ = x.template head<N>();
+    P_ = P.template topLeftCorner<N, N>();
+    return true;
+  }
 
  protected:
   explicit CartesianRadarEstimator(Settings s)
