@@ -1,4 +1,4 @@
-// Purpose: the per-track estimator contract (estimator.hpp) held by every filter type that declares one: predict_measurement agrees with the update it predicts, clone() runs on identically, and the estimator alone gives what its filter node publishes.
+// Purpose: the per-track estimator contract (estimator.hpp) held by every filter type that declares one: predict_measurement agrees with the update it predicts, clone() runs on identically, the estimator alone gives what its filter node publishes, and the Cartesian ones name their transition model, declared by the one block.
 #include <trackflow/geometry.hpp>
 #include <trackflow/rng.hpp>
 #include <trackflow/single_track_filter.hpp>
@@ -216,4 +216,74 @@ TEST_CASE("the estimator alone gives what its node publishes") {
     CHECK(last_node.covariance == alone.back().covariance);
     CHECK(filter.state_layout().dim == e->layout().dim);
   }
+}
+
+// The estimators with a Cartesian kinematic state name the transition model they predict with
+// (a fusion node predicts their estimates with it), as their parameters give it; the others
+// (spherical state, paper-specific states, a mixture of modes) name none.
+TEST_CASE("estimators name the transition model of their parameters") {
+  using Motion = TransitionModel::Motion;
+  using Noise = TransitionModel::Noise;
+  struct Expected {
+    std::string type, params;
+    bool has;
+    Motion motion;
+    Noise noise;
+    double intensity;
+  };
+  const std::vector<Expected> expected = {
+      {"filter.kalman", "{q: 2 m2/s3}", true, Motion::ConstantVelocity, Noise::Continuous, 2.0},
+      {"filter.kalman", "{motion: constant_acceleration, sigma_accel: 3 m/s2}", true, Motion::ConstantAcceleration,
+       Noise::Discrete, 3.0},
+      {"filter.decoupled", "{q: 4 m2/s3}", true, Motion::ConstantVelocity, Noise::Continuous, 4.0},
+      {"filter.ekf", "{motion: constant_acceleration, q_jerk: 5 m2/s5}", true, Motion::ConstantAcceleration,
+       Noise::Continuous, 5.0},
+      {"filter.ukf", "{motion: singer, singer_alpha: 0.5 1/s, singer_sigma: 6 m/s2}", true, Motion::Singer, Noise::Singer, 6.0},
+      {"filter.gain_transform", "{singer_sigma: 7 m/s2}", true, Motion::Singer, Noise::Singer, 7.0},
+      {"filter.ekf_spherical", "{}", false, Motion::ConstantVelocity, Noise::Continuous, 0.0},
+      {"filter.refraction_ekf", "{}", false, Motion::ConstantVelocity, Noise::Continuous, 0.0},
+      {"filter.imm", cases()[8].params, false, Motion::ConstantVelocity, Noise::Continuous, 0.0},
+  };
+  for (const Expected& x : expected) {
+    INFO(x.type << " " << x.params);
+    auto e = test::fixture().make_estimator(x.type, x.params);
+    const TransitionModel* t = e->transition_model();
+    REQUIRE((t != nullptr) == x.has);
+    if (!t) continue;
+    CHECK(t->motion == x.motion);
+    CHECK(t->noise == x.noise);
+    CHECK(t->intensity == x.intensity);
+  }
+  // gain_transform's Singer alpha defaults to paper 002's 1/s; ukf's is the one given.
+  CHECK(test::fixture().make_estimator("filter.gain_transform", "{singer_sigma: 7 m/s2}")->transition_model()->singer_alpha == 1.0);
+  CHECK(test::fixture()
+            .make_estimator("filter.ukf", "{motion: singer, singer_alpha: 0.5 1/s, singer_sigma: 6 m/s2}")
+            ->transition_model()
+            ->singer_alpha == 0.5);
+}
+
+// The motion block is declared once (transition_model.hpp): every filter that offers a motion
+// parameter declares each of the block's parameters with the same dimension and text.
+TEST_CASE("filters declare the one transition-model block") {
+  const std::vector<ParamSpec> block = transition_param_specs();
+  int users = 0;
+  for (const char* type : {"filter.kalman", "filter.decoupled", "filter.ekf", "filter.ukf", "filter.gain_transform",
+                           "filter.track_fusion"}) {
+    INFO(type);
+    const ComponentDecl* d = nullptr;
+    for (const auto& r : test::registry().types())
+      if (r.decl.type == type) d = &r.decl;
+    REQUIRE(d);
+    bool uses = false;
+    for (const ParamSpec& mine : d->params)
+      for (const ParamSpec& ref : block) {
+        if (mine.name != ref.name) continue;
+        uses = true;
+        CHECK(mine.type == ref.type);
+        CHECK(mine.dimension == ref.dimension);
+        if (mine.name != "motion" && mine.name != "sigma_accel") CHECK(mine.doc == ref.doc);
+      }
+    users += uses;
+  }
+  CHECK(users == 6);
 }

@@ -361,7 +361,10 @@ GraphInstance instantiate_checked(const Graph& g, const PluginRegistry& registry
     for (size_t k = 0; k < n.inputs.size(); ++k) {
       const int up = n.inputs[k];
       InputInfo info{g.nodes[up].config.id, g.nodes[up].config.type, n.input_kinds[k], annotations[up]};
-      if (const auto* f = dynamic_cast<const Filter*>(inst.components[up].get())) info.state = f->state_layout();
+      if (const auto* f = dynamic_cast<const Filter*>(inst.components[up].get())) {
+        info.state = f->state_layout();
+        if (const TransitionModel* t = f->transition_model()) info.transition = *t;
+      }
       info.time_ordered = time_ordered[up];
       infos.push_back(std::move(info));
     }

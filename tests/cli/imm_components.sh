@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Purpose: filter.imm with modes given as components (issue 20): an EKF mode and a UKF mode run from YAML; a wrong nested parameter, a mode that cannot be mixed and modes that accept different measurements are refused at the mode's own file:line:col.
+# Purpose: filter.imm with modes given as components (issue 20): an EKF mode and a UKF mode run from YAML, the modes' counters reported; a wrong nested parameter, a mode that cannot be mixed and modes that accept different measurements are refused at the mode's own file:line:col.
 set -u
 TF=$1
 DATA=$3
@@ -9,6 +9,13 @@ P="$DATA/imm_ekf_ukf.yaml"  # line 23: the EKF mode, line 24: the UKF mode
 
 expect_run "an IMM of an EKF CV mode and a UKF CA mode runs and meets its expect checks" 0 "4 passed, 0 failed" \
   -- "$TF" run "$P" --no-progress --out "$TMP/run"
+
+# A mode's own counters reach the IMM's summary as <mode>.<counter>: over the radar's zenith
+# the EKF mode drops azimuths (the same pipeline with the target passing overhead).
+sed -e "s|initial_position: \[-5 km, 20 km, 3 km\]|initial_position: [-3 km, 0 km, 3 km]|" -e '/^expect:/,$d' "$P" > "$TMP/zenith.yaml"
+expect_run "the EKF mode's azimuth_dropped counter is reported by the IMM" 0 \
+  "ekf_cv\.azimuth_dropped +[1-9][0-9]*$" \
+  -- "$TF" run "$TMP/zenith.yaml" --no-progress --out "$TMP/zenith"
 
 # Each variant is the pipeline with line 24 (the UKF mode) changed; the errors point into that line.
 variant() {

@@ -12,6 +12,16 @@ namespace trackflow {
 // Whether a spherical filter uses the measurement's range rate (the 4th value).
 enum class RangeRateUse : std::uint8_t { Auto, Use, Ignore };
 
+// The word range_rate_param() reads as `r`, for messages.
+inline const char* to_string(RangeRateUse r) {
+  switch (r) {
+    case RangeRateUse::Auto: return "auto";
+    case RangeRateUse::Use: return "use";
+    case RangeRateUse::Ignore: return "ignore";
+  }
+  return "?";
+}
+
 inline ParamSpec range_rate_param() {
   return ParamSpec::choice<RangeRateUse>(
              "range_rate", {{RangeRateUse::Auto, "auto"}, {RangeRateUse::Use, "use"}, {RangeRateUse::Ignore, "ignore"}},

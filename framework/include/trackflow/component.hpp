@@ -6,12 +6,14 @@
 #include <trackflow/tracks.hpp>
 #include <trackflow/noise.hpp>
 #include <trackflow/series.hpp>
+#include <trackflow/transition_model.hpp>
 
 #include <boost/config.hpp>
 
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -110,6 +112,9 @@ struct InputInfo {
   // Whether this input's items arrive in non-decreasing time within a run (every source upstream
   // declares ComponentDecl::time_ordered), so a sink may score an item as soon as its truth is known.
   bool time_ordered = false;
+  // A filter's input: the transition model it predicts with (Filter::transition_model), when it
+  // has one of transition_model.hpp's; a fusion node predicts the inputs' estimates with it.
+  std::optional<TransitionModel> transition;
 };
 
 struct FinishContext {
@@ -209,6 +214,9 @@ class BOOST_SYMBOL_VISIBLE Filter : public Component {
   // The noise adapters may read and overwrite, with what each number is (noise.hpp).
   virtual NoiseHandles noise() { return {}; }
   virtual StateLayout state_layout() const { return {}; }
+  // The kinematic model the filter predicts with, as configured (adapters may retune its noise
+  // per track); nullptr when its state is not one of transition_model.hpp's models.
+  virtual const TransitionModel* transition_model() const { return nullptr; }
   // Names of values the filter itself publishes on every estimate (e.g. an IMM's mode
   // probabilities); they come first in the estimate's annotations, before its adapters', and
   // sinks see them as "<filter id>.<name>". Set with annotate_own().

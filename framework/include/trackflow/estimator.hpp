@@ -5,6 +5,7 @@
 #include <trackflow/geometry.hpp>
 #include <trackflow/items.hpp>
 #include <trackflow/noise.hpp>
+#include <trackflow/transition_model.hpp>
 
 #include <Eigen/Cholesky>
 #include <Eigen/Core>
@@ -111,6 +112,8 @@ class Estimator {
   // IMM's mixed start, keeping everything else (motion model, noise, initialisation). false: this
   // estimator cannot take a state from outside (it cannot be a filter.imm mode); nothing changed.
   virtual bool assign(const StateVec& /*x*/, const StateCov& /*P*/) { return false; }
+  // Optional: the kinematic model the estimator predicts with, as configured (Filter::transition_model).
+  virtual const TransitionModel* transition_model() const { return nullptr; }
 
   const MeasurementSpec& measurement_spec() const { return spec_; }
   void bind(TrackContext& track) { track_ = &track; }

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <stdexcept>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -23,7 +24,7 @@ namespace trackflow {
 
 // Counts of one run, summed in run order into the node's summary.
 struct SingleTrackRunResult final : RunResult {
-  static constexpr int kMaxCounters = 4;
+  static constexpr int kMaxCounters = 12;  // an IMM of four modes with two counters each, and its own
   std::uint64_t updates = 0;     // measurements used
   std::uint64_t coasted = 0;     // invalid measurements: predicted through
   std::uint64_t non_finite = 0;  // flagged valid but non-finite (value or R): predicted through
@@ -62,6 +63,10 @@ class SingleTrackFilter final : public Filter, public FieldListCodec<SingleTrack
     TrackContext::who = type_ + " (node '" + node_ + "')";
     TrackContext::estimate = &estimate_;
     estimator_.bind(*this);  // public in Estimator
+    if (est().measurement_spec().counters.size() > static_cast<size_t>(SingleTrackRunResult::kMaxCounters))
+      throw std::length_error(TrackContext::who + " declares " + std::to_string(est().measurement_spec().counters.size()) +
+                              " counters; a single-track node counts at most " +
+                              std::to_string(SingleTrackRunResult::kMaxCounters) + " (a bug in that plugin)");
     const int n = est().layout().dim;
     estimate_.state = StateVec::Zero(n);
     estimate_.covariance = StateCov::Zero(n, n);
@@ -71,6 +76,7 @@ class SingleTrackFilter final : public Filter, public FieldListCodec<SingleTrack
 
   NoiseHandles noise() override { return est().noise(); }
   StateLayout state_layout() const override { return est().layout(); }
+  const TransitionModel* transition_model() const override { return est().transition_model(); }
   std::vector<std::string> annotation_names() const override { return est().annotation_names(); }
   const E& estimator() const { return estimator_; }
 

@@ -5,6 +5,7 @@
 #include <trackflow/single_track_filter.hpp>
 #include <trackflow/motion.hpp>
 #include <trackflow/plugin.hpp>
+#include <trackflow/transition_model.hpp>
 
 #include <string>
 
@@ -16,13 +17,14 @@ using decoupled::DecoupledCv;
 enum class FrameChange { Reproject, Carry };
 
 struct DecoupledSettings {
+  TransitionModel transition;  // as configured (constant velocity); q and noise below are what adapters retune
   enum class Noise { Continuous, Discrete } noise = Noise::Continuous;
   double q = 1.0;  // continuous: white-acceleration PSD, m2/s3; discrete: its std, m/s2 (every axis)
   bool reproject = true;
   std::string node;
 };
 
-// The measurement front end is the SDK's (filter_front_end.hpp); this class is the model.
+// The estimator of one track; the filter node around it is the SDK's SingleTrackFilter (single_track_filter.hpp).
 class DecoupledEstimator final : public Estimator {
 
  public:
@@ -47,6 +49,7 @@ class DecoupledEstimator final : public Estimator {
     return h;
   }
 
+  const TransitionModel* transition_model() const override { return &s_.transition; }
   StateLayout layout() const override {
     static constexpr StateComponent kLayout[] = {{"x", "m"}, {"vx", "m/s"}, {"y", "m"},
                                                  {"vy", "m/s"}, {"z", "m"}, {"vz", "m/s"}};
@@ -144,14 +147,10 @@ class DecoupledEstimator final : public Estimator {
 DecoupledEstimator make_estimator(const Params& p) {
   DecoupledSettings s;
   s.node = p.node();
-  if (p.given("sigma_accel") && p.given("q"))
-    throw p.error("sigma_accel", "give either the continuous-noise intensity q or sigma_accel, not both");
-  if (p.given("sigma_accel")) {
-    s.noise = DecoupledSettings::Noise::Discrete;
-    s.q = p.real("sigma_accel");
-  } else {
-    s.q = p.real("q");
-  }
+  s.transition = parse_transition(p, TransitionChoices::constant_velocity_only());
+  s.noise = s.transition.noise == TransitionModel::Noise::Discrete ? DecoupledSettings::Noise::Discrete
+                                                                    : DecoupledSettings::Noise::Continuous;
+  s.q = s.transition.intensity;
   s.reproject = p.choice<FrameChange>("frame_change") == FrameChange::Reproject;
   return DecoupledEstimator(s);
 }
@@ -189,16 +188,12 @@ void register_components(Registrar& r) {
   d.accepts = mask(ItemKind::Measurement);
   d.accepts_frames = mask(Frame::Cartesian);
   d.produces = mask(ItemKind::Estimate);
-  d.params = {
-      ParamSpec::real("q", dim::accel_psd, "spectral density of the white acceleration noise, every axis").def("1 m2/s3").at_least(0),
-      ParamSpec::real("sigma_accel", dim::acceleration,
-                      "discrete white-noise model instead (paper eq 16-17): std of the acceleration, every axis")
-          .at_least(0),
+  d.params = transition_param_specs(TransitionChoices::constant_velocity_only());
+  d.params.push_back(
       ParamSpec::choice<FrameChange>("frame_change", {{FrameChange::Reproject, "reproject"}, {FrameChange::Carry, "carry"}},
                         "when the line of sight turns: re-express the per-axis covariances in the new frame, or carry "
                         "them over unchanged as the paper writes it")
-          .def("reproject"),
-  };
+          .def("reproject"));
   d.create = create;
   d.create_estimator = create_estimator;
   r.add(std::move(d));

@@ -5,10 +5,12 @@
 #include <trackflow/geometry.hpp>
 #include <trackflow/motion.hpp>
 #include <trackflow/plugin.hpp>
+#include <trackflow/transition_model.hpp>
 #include <trackflow/spherical_measurement.hpp>
 
 #include <cmath>
 #include <string>
+#include <vector>
 
 namespace trackflow {
 namespace {
@@ -18,6 +20,7 @@ using namespace gain_transform;
 enum class FrameChange { Reproject, Carry };
 
 struct GainTransformSettings {
+  TransitionModel transition;  // as configured (Singer)
   double alpha = 1.0;          // Singer inverse correlation time, 1/s, the same on all axes
   double sigma = 1.0;          // Singer sigma_m, m/s2 (per ENU axis, adapters may retune each)
   double sigma_accel0 = 1.0;   // initial acceleration std
@@ -29,7 +32,7 @@ struct GainTransformSettings {
 // position, the azimuth can flip by pi over the uncertainty and is not used (as filter.ekf).
 constexpr double kZenithSigmas = 3.0;
 
-// The measurement front end is the SDK's (filter_front_end.hpp); this class is the model.
+// The estimator of one track; the filter node around it is the SDK's SingleTrackFilter (single_track_filter.hpp).
 class GainTransformEstimator final : public Estimator {
 
  public:
@@ -39,6 +42,7 @@ class GainTransformEstimator final : public Estimator {
     for (double& q : q_) q = s_.sigma;
   }
 
+  const TransitionModel* transition_model() const override { return &s_.transition; }
   NoiseHandles noise() override {
     NoiseHandles h;
     h.measurement = {&R_, MeasurementSpace::Spherical};
@@ -228,12 +232,16 @@ class GainTransformEstimator final : public Estimator {
   double tc_[2] = {};
 };
 
+// Paper 002's model is Singer's, alpha 1/s by default.
+TransitionChoices transition_choices() { return TransitionChoices::singer_only("1 1/s"); }
+
 // The estimator of one track from the node's parameters (the node and a tracker take it alike).
 GainTransformEstimator make_estimator(const Params& p) {
   GainTransformSettings s;
   s.node = p.node();
-  s.alpha = p.real("singer_alpha");
-  s.sigma = p.real("singer_sigma");
+  s.transition = parse_transition(p, transition_choices());
+  s.alpha = s.transition.singer_alpha;
+  s.sigma = s.transition.intensity;
   s.sigma_accel0 = p.real_or("initial_sigma_acceleration", s.sigma);
   s.reproject = p.choice<FrameChange>("frame_change") == FrameChange::Reproject;
   return GainTransformEstimator(s);
@@ -266,14 +274,8 @@ void register_components(Registrar& r) {
   d.accepts = mask(ItemKind::Measurement);
   d.accepts_frames = mask(Frame::Spherical);
   d.produces = mask(ItemKind::Estimate);
-  d.params = {
-      ParamSpec::real("singer_alpha", dim::frequency,
-                      "Singer inverse correlation time of the acceleration, the same on all axes (paper 002: 1.0)")
-          .def("1 1/s")
-          .positive(),
-      ParamSpec::real("singer_sigma", dim::acceleration, "Singer standard deviation sigma_m of the acceleration")
-          .req()
-          .positive(),
+  d.params = transition_param_specs(transition_choices());
+  d.params.insert(d.params.end(), {
       ParamSpec::real("initial_sigma_acceleration", dim::acceleration,
                       "initial acceleration std (default: singer_sigma, the stationary prior)")
           .positive(),
@@ -281,7 +283,7 @@ void register_components(Registrar& r) {
                         "when the line of sight turns: re-express the LOS covariance blocks in the new frame, or "
                         "carry them unchanged (the paper's equations)")
           .def("reproject"),
-  };
+  });
   d.create = create;
   d.create_estimator = create_estimator;
   r.add(std::move(d));

@@ -395,6 +395,9 @@ TEST_CASE("wrong inputs and parameters are clear errors") {
   CHECK_THAT(error("{ singer_sigma: -1 m/s2 }"), Catch::Contains("singer_sigma"));
   CHECK_THAT(error("{ singer_sigma: 20 m/s2, singer_alpha: 0 1/s }"), Catch::Contains("singer_alpha"));
   CHECK_THAT(error("{ singer_sigma: 20 m/s2, frame_change: rotate }"), Catch::Contains("frame_change"));
-  CHECK_THAT(error("{ singer_sigma: 20 m/s2, motion: singer }"), Catch::Contains("motion"));
+  // The transition-model block offers paper 002's Singer model only: another motion is refused.
+  CHECK_THAT(error("{ singer_sigma: 20 m/s2, motion: constant_velocity }"), Catch::Contains("motion"));
+  CHECK_THAT(error("{ singer_sigma: 20 m/s2, q: 1 m2/s3 }"), Catch::Contains("unknown parameter 'q'"));
+  CHECK(error("{ singer_sigma: 20 m/s2, motion: singer }") == "no error");
   CHECK(error("{ singer_sigma: 20 m/s2, frame_change: carry, initial_sigma_acceleration: 5 m/s2 }") == "no error");
 }

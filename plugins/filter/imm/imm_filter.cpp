@@ -275,13 +275,18 @@ struct ComponentImmConfig {
   std::vector<double> transition, initial;
 };
 
-// A mode's track: its warnings are collected and passed on (named) by the IMM, its counts and
-// annotations dropped; `estimate` receives the innovation of its accepted update.
+class ComponentImmEstimator;
+
+// A mode's track: its warnings are collected and passed on (named) by the IMM, its counts go to
+// the IMM's counters "<mode>.<counter>" (from `first_counter` on), its annotations are dropped
+// (they would clash between modes); `estimate` receives the innovation of its accepted update.
 struct ModeTrack final : TrackContext {
   void warn(const std::string& message) override { warnings.push_back(message); }
-  void count(int) override {}
+  void count(int counter) override;
   void annotate(int, double) override {}
   std::vector<std::string> warnings;
+  ComponentImmEstimator* imm = nullptr;
+  int first_counter = 0;
 };
 
 // An owned mode estimator that a copy clones.
@@ -302,11 +307,13 @@ struct OwnedEstimator {
 // likelihood from the innovation of its own update (nu, S, NIS through its ModeTrack).
 class ComponentImmEstimator final : public Estimator {
  public:
-  explicit ComponentImmEstimator(const ComponentImmConfig& c)
-      : Estimator(MeasurementSpec{Frame::Spherical, c.range_rate, {"mode_updates_refused"}, c.tilted_sensors}) {
+  explicit ComponentImmEstimator(const ComponentImmConfig& c) : Estimator(spec(c)) {
     count_ = static_cast<int>(c.modes.size());
+    int next_counter = 1;  // after mode_updates_refused
     for (int j = 0; j < count_; ++j) {
       const EstimatorMode& m = c.modes[static_cast<size_t>(j)];
+      st_.tracks[j].first_counter = next_counter;
+      next_counter += static_cast<int>(m.prototype->measurement_spec().counters.size());
       st_.names[j] = m.name;
       st_.dim[j] = m.dim;
       for (int r = 0; r < m.dim && r < kMaxStateDim; ++r) st_.common[j][r] = m.common[r];
@@ -344,8 +351,18 @@ class ComponentImmEstimator final : public Estimator {
 
   Estimator& mode(int j) { return *st_.modes[j].e; }
   const Estimator& mode(int j) const { return *st_.modes[j].e; }
+  friend struct ModeTrack;
+  // The IMM's counters: its own, then each mode's own as "<mode>.<counter>".
+  static MeasurementSpec spec(const ComponentImmConfig& c) {
+    MeasurementSpec m{Frame::Spherical, c.range_rate, {"mode_updates_refused"}, c.tilted_sensors};
+    for (const EstimatorMode& mode : c.modes)
+      for (const std::string& counter : mode.prototype->measurement_spec().counters)
+        m.counters.push_back(mode.name + "." + counter);
+    return m;
+  }
   void rebind() {
     for (int j = 0; j < count_; ++j) {
+      st_.tracks[j].imm = this;
       st_.tracks[j].estimate = &st_.outcome[j];
       mode(j).bind(st_.tracks[j]);
     }
@@ -535,13 +552,8 @@ class ComponentImmEstimator final : public Estimator {
   mutable imm::MatC P0_ = imm::MatC::Zero();
 };
 
-const char* range_rate_word(RangeRateUse r) {
-  switch (r) {
-    case RangeRateUse::Auto: return "auto";
-    case RangeRateUse::Use: return "use";
-    case RangeRateUse::Ignore: return "ignore";
-  }
-  return "?";
+void ModeTrack::count(int counter) {
+  if (imm) imm->count(first_counter + counter);
 }
 
 // The mode name in the annotations: <type without "filter.">_<cv|ca|singer> when the type has a
@@ -576,8 +588,8 @@ ComponentImmConfig make_component_config(const Params& p) {
     if (k == 0) {
       c.range_rate = spec.range_rate;
     } else if (spec.range_rate != c.range_rate) {
-      throw ConfigError(label + ": range_rate " + range_rate_word(spec.range_rate) + ", but mode 1 has " +
-                            range_rate_word(c.range_rate) + "; every mode must accept the same measurements",
+      throw ConfigError(label + ": range_rate " + to_string(spec.range_rate) + ", but mode 1 has " +
+                            to_string(c.range_rate) + "; every mode must accept the same measurements",
                         nc.params.given("range_rate") ? nc.params.where("range_rate") : nc.type_where, p.node());
     }
     c.tilted_sensors = c.tilted_sensors && spec.tilted_sensors;
@@ -613,14 +625,14 @@ ComponentImmConfig make_component_config(const Params& p) {
     c.modes.push_back(std::move(m));
   }
   if (p.given("range_rate") && p.choice<RangeRateUse>("range_rate") != c.range_rate)
-    throw p.error("range_rate", std::string("the modes use range_rate ") + range_rate_word(c.range_rate) +
+    throw p.error("range_rate", std::string("the modes use range_rate ") + to_string(c.range_rate) +
                                     "; with modes given as components, set it in each mode");
   return c;
 }
 
 std::vector<ParamSpec> mode_fields() {
   std::vector<ParamSpec> f = {ParamSpec::string("name", "mode name in the annotations (p_<name>); default cv, ca or singer")};
-  for (ParamSpec& s : cartesian_filter::motion_param_specs()) f.push_back(std::move(s));
+  for (ParamSpec& s : transition_param_specs()) f.push_back(std::move(s));
   f.push_back(cartesian_filter::initial_sigma_acceleration_param());
   return f;
 }
@@ -669,7 +681,7 @@ ImmEstimator make_estimator(const Params& p) {
     Settings s;
     s.type = "filter.imm";
     s.node = c.node;
-    cartesian_filter::parse_motion(r, s);
+    static_cast<TransitionModel&>(s) = parse_transition(r);
     s.range_rate = c.range_rate;
     s.zenith = zenith;
     s.init = Settings::Init::TwoPoint;

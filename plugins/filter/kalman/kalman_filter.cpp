@@ -4,17 +4,19 @@
 #include <trackflow/kalman.hpp>
 #include <trackflow/motion.hpp>
 #include <trackflow/plugin.hpp>
+#include <trackflow/transition_model.hpp>
 
 #include <cmath>
 #include <limits>
+#include <vector>
 
 namespace trackflow {
 namespace {
 
-enum class Motion { ConstantVelocity, ConstantAcceleration };
 enum class Init { TwoPoint, Explicit };
 
 struct KalmanSettings {
+  TransitionModel transition;  // as configured; q and noise below are what adapters may retune
   enum class Noise { Continuous, Discrete } noise = Noise::Continuous;
   double q = 1.0;  // continuous: PSD of the highest derivative (CV m2/s3, CA m2/s5); discrete: its std
   bool two_point = true;
@@ -42,6 +44,7 @@ class KalmanEstimator final : public Estimator {
   }
   std::unique_ptr<Estimator> clone() const override { return std::make_unique<KalmanEstimator>(*this); }
 
+  const TransitionModel* transition_model() const override { return &s_.transition; }
   NoiseHandles noise() override {
     NoiseHandles h;
     h.measurement = {&R_, MeasurementSpace::CartesianPosition};
@@ -224,19 +227,20 @@ class KalmanEstimator final : public Estimator {
   int idx_[6] = {};
 };
 
+// filter.kalman's models: constant velocity or acceleration, continuous or discrete noise (no Singer).
+TransitionChoices transition_choices() {
+  TransitionChoices c;
+  c.singer = false;
+  return c;
+}
+
 KalmanSettings parse_settings(const Params& p) {
   KalmanSettings s;
-  const bool ca = p.choice<Motion>("motion") == Motion::ConstantAcceleration;
-  if (p.given("sigma_accel") && (p.given("q") || p.given("q_jerk")))
-    throw p.error("sigma_accel", "give either a continuous-noise intensity (q / q_jerk) or sigma_accel, not both");
-  if (ca && p.given("q")) throw p.error("q", "q (m2/s3) is the CV intensity; the CA model takes q_jerk (m2/s5)");
-  if (!ca && p.given("q_jerk")) throw p.error("q_jerk", "q_jerk is for motion: constant_acceleration; CV takes q");
-  if (p.given("sigma_accel")) {
-    s.noise = KalmanSettings::Noise::Discrete;
-    s.q = p.real("sigma_accel");
-  } else {
-    s.q = ca ? p.real("q_jerk") : p.real("q");
-  }
+  s.transition = parse_transition(p, transition_choices());
+  const bool ca = s.transition.motion == TransitionModel::Motion::ConstantAcceleration;
+  s.noise = s.transition.noise == TransitionModel::Noise::Discrete ? KalmanSettings::Noise::Discrete
+                                                                    : KalmanSettings::Noise::Continuous;
+  s.q = s.transition.intensity;
   s.two_point = p.choice<Init>("init") == Init::TwoPoint;
   if (!s.two_point) {
     for (const char* req : {"initial_position", "initial_sigma_position", "initial_sigma_velocity"})
@@ -280,19 +284,8 @@ void register_components(Registrar& r) {
   d.accepts = mask(ItemKind::Measurement);
   d.accepts_frames = mask(Frame::Cartesian);
   d.produces = mask(ItemKind::Estimate);
-  d.params = {
-      ParamSpec::choice<Motion>("motion",
-                                {{Motion::ConstantVelocity, "constant_velocity"},
-                                 {Motion::ConstantAcceleration, "constant_acceleration"}},
-                                "motion model")
-          .def("constant_velocity"),
-      ParamSpec::real("q", dim::accel_psd, "CV: spectral density of the white acceleration noise").def("1 m2/s3").at_least(0),
-      ParamSpec::real("q_jerk", dim::jerk_psd, "CA: spectral density of the white jerk noise (paper 000 eq 3.19)")
-          .def("1 m2/s5")
-          .at_least(0),
-      ParamSpec::real("sigma_accel", dim::acceleration,
-                      "discrete white-noise model instead: std of the acceleration (CV) or acceleration increment (CA)")
-          .at_least(0),
+  d.params = transition_param_specs(transition_choices());
+  d.params.insert(d.params.end(), {
       ParamSpec::choice<Init>("init", {{Init::TwoPoint, "two_point"}, {Init::Explicit, "explicit"}},
                               "two-point differencing or the initial_* values")
           .def("two_point"),
@@ -304,7 +297,7 @@ void register_components(Registrar& r) {
       ParamSpec::real("initial_sigma_acceleration", dim::acceleration, "CA: initial acceleration std (both inits)")
           .def("50 m/s2")
           .positive(),
-  };
+  });
   d.create = create;
   d.create_estimator = create_estimator;
   r.add(std::move(d));

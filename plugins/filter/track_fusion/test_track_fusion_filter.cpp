@@ -1,4 +1,4 @@
-// Purpose: tests of filter.track_fusion as a node: information fusion of two local tracks equals the hand-computed sum of their information, CI publishes a fused estimate, a mismatched state size is refused, the shared motion block's checks.
+// Purpose: tests of filter.track_fusion as a node: information fusion of two local tracks equals the hand-computed sum of their information, CI publishes a fused estimate, a mismatched state size is refused, the shared motion block's checks, the inputs' transition model taken or a different one refused.
 #include <catch2/catch.hpp>
 
 #include "plugin_fixture.hpp"
@@ -79,8 +79,8 @@ TEST_CASE("track_fusion: node refuses another state size") {
   CHECK_THROWS_AS(n->on_estimate(cv_estimate(0.0, 0.0, 1.0), 0), DataError);
 }
 
-// The motion block is the Cartesian filters' own (lib/estimation): the same checks of its
-// combination, each naming its parameter.
+// The motion block is the SDK's transition-model block (transition_model.hpp), as every filter
+// declares it: the same checks of its combination, each naming its parameter.
 TEST_CASE("track_fusion: shared motion block checks") {
   const auto refused = [](const std::string& yaml, const std::string& param) {
     try {
@@ -95,4 +95,70 @@ TEST_CASE("track_fusion: shared motion block checks") {
   CHECK(refused("{motion: singer, singer_alpha: 1 1/s}", "singer_sigma"));
   CHECK(refused("{q: 1 m2/s3, sigma_accel: 1 m/s2}", "sigma_accel"));
   CHECK_NOTHROW(test::make("filter.track_fusion", "{motion: singer, singer_alpha: 1 1/s, singer_sigma: 5 m/s2}"));
+}
+
+namespace {
+
+InputInfo filter_input(const std::string& id, const TransitionModel& t) {
+  InputInfo in{id, "filter.ekf", mask(ItemKind::Estimate), {}};
+  in.transition = t;
+  return in;
+}
+
+TransitionModel constant_acceleration(double q_jerk) {
+  TransitionModel t;
+  t.motion = TransitionModel::Motion::ConstantAcceleration;
+  t.intensity = q_jerk;
+  return t;
+}
+
+std::string refusal(Component& n, const std::vector<InputInfo>& inputs) {
+  try {
+    n.set_inputs(inputs);
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+}  // namespace
+
+// Without motion parameters the node predicts with its inputs' model: a 9-state CA model from
+// the inputs makes it take 9-state estimates and refuse 6-state ones.
+TEST_CASE("track_fusion: takes the inputs' transition model") {
+  test::Collector out;
+  auto n = test::make("filter.track_fusion", "{method: information}");
+  n->set_inputs({filter_input("a", constant_acceleration(2.0)), filter_input("b", constant_acceleration(2.0))});
+  out.attach_to(*n);
+  testing::start_run(*n);
+  Estimate e = cv_estimate(0.0, 0.0, 1.0);
+  CHECK_THROWS_AS(n->on_estimate(e, 0), DataError);
+  e.state = StateVec::Zero(9);
+  e.covariance = StateCov::Identity(9, 9);
+  n->on_estimate(e, 0);
+  REQUIRE(out.estimates.size() == 1);
+  CHECK(out.estimates[0].initialised);
+  CHECK(out.estimates[0].state.size() == 9);
+}
+
+// Inputs that predict differently, or a node model other than its inputs', are refused before
+// the run, naming both; with no model anywhere the node asks for one.
+TEST_CASE("track_fusion: refuses models that differ") {
+  auto inherit = test::make("filter.track_fusion", "{}");
+  const std::string two = refusal(*inherit, {filter_input("a", constant_acceleration(1.0)), filter_input("b", constant_acceleration(3.0))});
+  CHECK(two.find("input 'b'") != std::string::npos);
+  CHECK(two.find("q_jerk 3 m2/s5") != std::string::npos);
+  CHECK(two.find("input 'a' with constant_acceleration, q_jerk 1 m2/s5") != std::string::npos);
+
+  auto given = test::make("filter.track_fusion", "{q: 5 m2/s3}");
+  const std::string own = refusal(*given, {filter_input("a", constant_acceleration(1.0))});
+  CHECK(own.find("this node's parameters give constant_velocity, q 5 m2/s3") != std::string::npos);
+  CHECK(own.find("leave the motion parameters out") != std::string::npos);
+
+  auto none = test::make("filter.track_fusion", "{}");
+  const std::string missing = refusal(*none, {{"a", "filter.x", mask(ItemKind::Estimate), {}}});
+  CHECK(missing.find("no input names its transition model") != std::string::npos);
+
+  auto same = test::make("filter.track_fusion", "{motion: constant_acceleration, q_jerk: 1 m2/s5}");
+  CHECK(refusal(*same, {filter_input("a", constant_acceleration(1.0)), filter_input("b", constant_acceleration(1.0))}).empty());
 }

@@ -1,28 +1,28 @@
 // Purpose: filter.track_fusion — track-to-track fusion of two or more filters' estimates (covariance intersection, or information matrix fusion that counts the common process noise once).
 #include "fusion_math.hpp"
 
-#include "estimation/cartesian_filter_settings.hpp"
-
 #include <trackflow/error.hpp>
 #include <trackflow/estimate_state.hpp>
 #include <trackflow/motion.hpp>
 #include <trackflow/plugin.hpp>
 #include <trackflow/run_result_codec.hpp>
+#include <trackflow/transition_model.hpp>
 
 #include <cmath>
 #include <memory>
 #include <string>
+#include <variant>
 #include <vector>
 
 namespace trackflow {
 namespace {
 
 enum class Method { CovarianceIntersection, Information, Independent };
-using Motion = cartesian_filter::MotionModel::Motion;
-using Noise = cartesian_filter::MotionModel::Noise;
+using Motion = TransitionModel::Motion;
+using Noise = TransitionModel::Noise;
 
-// The inputs' motion model (the Cartesian filters' parameter block), the fusion method.
-struct Settings : cartesian_filter::MotionModel {
+// The inputs' transition model (theirs, or the node's parameters), the fusion method.
+struct Settings : TransitionModel {
   Method method = Method::CovarianceIntersection;
   fusion::CiCriterion criterion = fusion::CiCriterion::Trace;
   std::string node;
@@ -42,60 +42,85 @@ struct FusionRunResult final : RunResult {
   }
 };
 
-// The local filters' estimates arrive in time order (the engine's merge; equal time stamps in
-// its delivery order). Each one is fused at its time with the latest estimate of every other
-// input (CI: predicted to that time with the motion model), or folded into the fused track
-// (information), and the fused estimate is published at that time.
+// The fused track's arithmetic for one state size (Order states per axis): every input's latest
+// estimate, the fused state, and the transition matrices of the last interval.
 template <int Order>
-class TrackFusion final : public Component, public FieldListCodec<FusionRunResult> {
+struct FusionCore {
   using Model = KinematicModel<Order>;
   static constexpr int N = Model::kDim;
   using Vec = Eigen::Matrix<double, N, 1>;
   using Mat = Eigen::Matrix<double, N, N>;
   using AxisMatrix = typename Model::AxisMatrix;
+  struct Local {
+    bool has = false;
+    double time = 0.0;
+    Vec x = Vec::Zero();
+    Mat P = Mat::Identity();
+  };
 
- public:
-  explicit TrackFusion(Settings s) : s_(std::move(s)) {
-    idx_[0] = Model::position_index(0), idx_[1] = Model::position_index(1), idx_[2] = Model::position_index(2);
-    idx_[3] = Model::velocity_index(0), idx_[4] = Model::velocity_index(1), idx_[5] = Model::velocity_index(2);
-    est_.state.resize(N);
-    est_.covariance.resize(N, N);
+  FusionCore() {
+    idx[0] = Model::position_index(0), idx[1] = Model::position_index(1), idx[2] = Model::position_index(2);
+    idx[3] = Model::velocity_index(0), idx[4] = Model::velocity_index(1), idx[5] = Model::velocity_index(2);
   }
+  void reset() {
+    for (Local& l : local) l = Local{};
+  }
+
+  Local local[kMaxInputs];
+  Vec xf = Vec::Zero();
+  Mat Pf = Mat::Identity();
+  Mat F = Mat::Identity(), Q = Mat::Zero();
+  double last_T = -1.0;
+  int idx[6] = {};
+};
+
+// The local filters' estimates arrive in time order (the engine's merge; equal time stamps in
+// its delivery order). Each one is fused at its time with the latest estimate of every other
+// input (CI: predicted to that time with the transition model), or folded into the fused track
+// (information), and the fused estimate is published at that time. The transition model is the
+// inputs' (InputInfo::transition) unless the node's parameters give it; the state size follows it.
+class TrackFusion final : public Component, public FieldListCodec<FusionRunResult> {
+ public:
+  // Until set_inputs gives the inputs' model, the node's own (given, or the default CV).
+  TrackFusion(Settings s, bool model_given) : s_(std::move(s)), model_given_(model_given) { choose_core(); }
 
   void set_inputs(const std::vector<InputInfo>& inputs) override {
     inputs_.clear();
     for (const InputInfo& in : inputs) inputs_.push_back(in.node);
+    // Every input that names its model must name the same one, and the node predicts with it.
+    const InputInfo* first = nullptr;
+    for (const InputInfo& in : inputs) {
+      if (!in.transition) continue;
+      if (!first) {
+        first = &in;
+        if (!model_given_) static_cast<TransitionModel&>(s_) = *in.transition;
+      }
+      if (*in.transition != static_cast<const TransitionModel&>(s_))
+        throw ConfigError("filter.track_fusion (node '" + s_.node + "'): input '" + in.node + "' (" + in.type +
+                          ") predicts with " + in.transition->text() + ", but " +
+                          (model_given_ ? std::string("this node's parameters give ")
+                                        : "input '" + first->node + "' with ") +
+                          s_.text() + "; the fused track must predict as its inputs do" +
+                          (model_given_ ? " (leave the motion parameters out to take the inputs' model)" : ""));
+    }
+    if (!first && !model_given_)
+      throw ConfigError("filter.track_fusion (node '" + s_.node + "'): no input names its transition model (" +
+                        (inputs.empty() ? std::string("no inputs") : "'" + inputs[0].node + "' is " + inputs[0].type) +
+                        "); give the local filters' motion and noise here (motion, q / q_jerk / sigma_accel / singer_*)");
+    choose_core();
   }
 
   void start_run(const RunContext& ctx) override {
     diag_ = ctx.diagnostics;
     run_ = FusionRunResult{};
-    for (Local& l : local_) l = Local{};
+    std::visit([](auto& core) { core.reset(); }, core_);
     fused_ = false;
     restart_reported_ = false;
   }
 
   void on_estimate(const Estimate& e, int port) override {
     if (port < 0 || port >= kMaxInputs) return;
-    Local& l = local_[port];
-    if (!e.initialised) {
-      if (l.has) restart("input '" + inputs_[port] + "' restarted its track", e.time);
-      l.has = false;
-      publish(e.time, e.updated);
-      return;
-    }
-    check_shape(e, port);
-    const Vec x = e.state.template head<N>();
-    const Mat P = e.covariance.template topLeftCorner<N, N>();
-    if (s_.method == Method::Information)
-      fold_in(l, x, P, e.time);
-    else
-      intersect(port, x, P, e.time);
-    l.has = true;
-    l.time = e.time;
-    l.x = x;
-    l.P = P;
-    publish(e.time, e.updated);
+    std::visit([&](auto& core) { fuse(core, e, port); }, core_);
   }
 
   std::unique_ptr<RunResult> end_run() override { return std::make_unique<FusionRunResult>(run_); }
@@ -114,26 +139,55 @@ class TrackFusion final : public Component, public FieldListCodec<FusionRunResul
   }
 
  private:
-  struct Local {
-    bool has = false;
-    double time = 0.0;
-    Vec x = Vec::Zero();
-    Mat P = Mat::Identity();
-  };
+  void choose_core() {
+    if (s_.order() == 2)
+      core_.emplace<FusionCore<2>>();
+    else
+      core_.emplace<FusionCore<3>>();
+    est_.state.resize(s_.state_dim());
+    est_.covariance.resize(s_.state_dim(), s_.state_dim());
+  }
 
-  void check_shape(const Estimate& e, int port) const {
-    if (e.state.size() != N || e.covariance.rows() != N || e.covariance.cols() != N)
+  template <class Core>
+  void fuse(Core& c, const Estimate& e, int port) {
+    constexpr int N = Core::N;
+    auto& l = c.local[port];
+    if (!e.initialised) {
+      if (l.has) restart("input '" + inputs_[port] + "' restarted its track", e.time);
+      l.has = false;
+      publish(c, e.time, e.updated);
+      return;
+    }
+    check_shape(e, port, N);
+    const typename Core::Vec x = e.state.template head<N>();
+    const typename Core::Mat P = e.covariance.template topLeftCorner<N, N>();
+    if (s_.method == Method::Information)
+      fold_in(c, l, x, P, e.time);
+    else
+      intersect(c, port, x, P, e.time);
+    l.has = true;
+    l.time = e.time;
+    l.x = x;
+    l.P = P;
+    publish(c, e.time, e.updated);
+  }
+
+  void check_shape(const Estimate& e, int port, int n) const {
+    if (e.state.size() != n || e.covariance.rows() != n || e.covariance.cols() != n)
       throw DataError("filter.track_fusion (node '" + s_.node + "'): input '" + inputs_[port] + "' publishes a " +
-                      std::to_string(e.state.size()) + "-element state; this node's motion model has " +
-                      std::to_string(N) + " (give it the local filters' motion and noise)");
+                      std::to_string(e.state.size()) + "-element state; this node's transition model (" + s_.text() +
+                      ") has " + std::to_string(n) + " (give it the local filters' motion and noise)");
   }
 
   // x <- F x, P <- F P F' + Q over T >= 0 (the local filters' model, so a local track's own
   // prediction is reproduced).
-  void predict(Vec& x, Mat& P, double T) {
+  template <class Core>
+  void predict(Core& c, typename Core::Vec& x, typename Core::Mat& P, double T) {
+    using Model = typename Core::Model;
+    constexpr int Order = Model::kOrder;
     if (!(T > 0.0)) return;
-    if (T != last_T_) {
-      AxisMatrix F, Q;
+    if (T != c.last_T) {
+      typename Core::AxisMatrix F, Q;
       if constexpr (Order == 3) {
         if (s_.motion == Motion::Singer) {
           F = SingerModel::axis_transition(s_.singer_alpha, T);
@@ -145,34 +199,35 @@ class TrackFusion final : public Component, public FieldListCodec<FusionRunResul
         Q = s_.noise == Noise::Continuous ? Model::axis_noise_continuous(T, 1.0) : Model::axis_noise_discrete(T, 1.0);
       }
       const double scale = s_.noise == Noise::Continuous ? s_.intensity : s_.intensity * s_.intensity;
-      F_.setZero();
-      Q_.setZero();
+      c.F.setZero();
+      c.Q.setZero();
       for (int a = 0; a < 3; ++a) {
-        F_.template block<Order, Order>(a * Order, a * Order) = F;
-        Q_.template block<Order, Order>(a * Order, a * Order) = scale * Q;
+        c.F.template block<Order, Order>(a * Order, a * Order) = F;
+        c.Q.template block<Order, Order>(a * Order, a * Order) = scale * Q;
       }
-      last_T_ = T;
+      c.last_T = T;
     }
-    x = F_ * x;
-    P = F_ * P * F_.transpose() + Q_;
+    x = c.F * x;
+    P = c.F * P * c.F.transpose() + c.Q;
     P = 0.5 * (P + P.transpose());
   }
 
   // Information matrix fusion: the fused track predicted to t, plus what this local update added.
-  void fold_in(Local& l, const Vec& x, const Mat& P, double t) {
-    if (fused_) predict(xf_, Pf_, t - tf_);
-    Vec xp = l.x;
-    Mat Pp = l.P;
-    if (l.has) predict(xp, Pp, t - l.time);
-    Vec xf = xf_;
-    Mat Pf = Pf_;
-    if (fusion::information_fusion<N>(xf, Pf, fused_, x, P, l.has, xp, Pp)) {
-      xf_ = xf;
-      Pf_ = Pf;
+  template <class Core>
+  void fold_in(Core& c, typename Core::Local& l, const typename Core::Vec& x, const typename Core::Mat& P, double t) {
+    if (fused_) predict(c, c.xf, c.Pf, t - tf_);
+    typename Core::Vec xp = l.x;
+    typename Core::Mat Pp = l.P;
+    if (l.has) predict(c, xp, Pp, t - l.time);
+    typename Core::Vec xf = c.xf;
+    typename Core::Mat Pf = c.Pf;
+    if (fusion::information_fusion<Core::N>(xf, Pf, fused_, x, P, l.has, xp, Pp)) {
+      c.xf = xf;
+      c.Pf = Pf;
     } else {
       restart("the fused information was not positive definite", t);
-      xf_ = x;
-      Pf_ = P;
+      c.xf = x;
+      c.Pf = P;
     }
     fused_ = true;
     tf_ = t;
@@ -180,29 +235,30 @@ class TrackFusion final : public Component, public FieldListCodec<FusionRunResul
 
   // Covariance intersection (or the independent-errors fusion) of this input's estimate with every
   // other input's latest, predicted to t, in input order.
-  void intersect(int port, const Vec& x, const Mat& P, double t) {
-    xf_ = x;
-    Pf_ = P;
+  template <class Core>
+  void intersect(Core& c, int port, const typename Core::Vec& x, const typename Core::Mat& P, double t) {
+    c.xf = x;
+    c.Pf = P;
     for (int j = 0; j < static_cast<int>(inputs_.size()) && j < kMaxInputs; ++j) {
-      if (j == port || !local_[j].has) continue;
-      Vec xj = local_[j].x;
-      Mat Pj = local_[j].P;
-      predict(xj, Pj, t - local_[j].time);
-      fusion::CiResult<N> r;
+      if (j == port || !c.local[j].has) continue;
+      typename Core::Vec xj = c.local[j].x;
+      typename Core::Mat Pj = c.local[j].P;
+      predict(c, xj, Pj, t - c.local[j].time);
+      fusion::CiResult<Core::N> r;
       const bool first_is_j = j < port;  // the first input's weight is the one reported
       bool ok;
       if (s_.method == Method::Independent)
-        ok = fusion::independent_fusion<N>(xf_, Pf_, xj, Pj, r);
+        ok = fusion::independent_fusion<Core::N>(c.xf, c.Pf, xj, Pj, r);
       else
-        ok = first_is_j ? fusion::covariance_intersection<N>(xj, Pj, xf_, Pf_, s_.criterion, r)
-                        : fusion::covariance_intersection<N>(xf_, Pf_, xj, Pj, s_.criterion, r);
+        ok = first_is_j ? fusion::covariance_intersection<Core::N>(xj, Pj, c.xf, c.Pf, s_.criterion, r)
+                        : fusion::covariance_intersection<Core::N>(c.xf, c.Pf, xj, Pj, s_.criterion, r);
       if (!ok) continue;  // that input is left out of this step
       if (s_.method == Method::CovarianceIntersection && (j == 0 || port == 0)) {
         run_.ci_weight_sum += r.w;
         ++run_.ci_count;
       }
-      xf_ = r.x;
-      Pf_ = r.P;
+      c.xf = r.x;
+      c.Pf = r.P;
     }
     fused_ = true;
     tf_ = t;
@@ -217,36 +273,34 @@ class TrackFusion final : public Component, public FieldListCodec<FusionRunResul
     fused_ = false;
   }
 
-  void publish(double t, bool updated) {
+  template <class Core>
+  void publish(Core& c, double t, bool updated) {
     est_.time = t;
     est_.updated = updated;
     est_.innovation.resize(0);
     est_.innovation_covariance.resize(0, 0);
     est_.nis = 0.0;
     est_.annotation_count = 0;
-    if (!fused_ || !xf_.allFinite() || !Pf_.allFinite()) {
+    if (!fused_ || !c.xf.allFinite() || !c.Pf.allFinite()) {
       if (fused_) restart("the fused state came out non-finite", t);
       set_uninitialised(est_, t);
       out.emit(est_);
       return;
     }
     est_.initialised = true;
-    set_estimate_state(est_, xf_, Pf_, idx_);
+    set_estimate_state(est_, c.xf, c.Pf, c.idx);
     ++run_.fused;
     out.emit(est_);
   }
 
   Settings s_;
+  bool model_given_ = false;
   std::vector<std::string> inputs_;
   Diagnostics* diag_ = nullptr;
   FusionRunResult run_, total_;
-  Local local_[kMaxInputs];
+  std::variant<FusionCore<2>, FusionCore<3>> core_;
   bool fused_ = false, restart_reported_ = false;
-  double tf_ = 0.0, last_T_ = -1.0;
-  Vec xf_ = Vec::Zero();
-  Mat Pf_ = Mat::Identity();
-  Mat F_ = Mat::Identity(), Q_ = Mat::Zero();
-  int idx_[6] = {};
+  double tf_ = 0.0;
   Estimate est_;
 };
 
@@ -257,15 +311,11 @@ Settings parse(const Params& p) {
   s.criterion = p.choice<fusion::CiCriterion>("ci_criterion");
   if (s.method != Method::CovarianceIntersection && p.given("ci_criterion"))
     throw p.error("ci_criterion", "is for method: covariance_intersection");
-  cartesian_filter::parse_motion(p, s);
+  if (transition_given(p)) static_cast<TransitionModel&>(s) = parse_transition(p);
   return s;
 }
 
-std::unique_ptr<Component> create(const Params& p) {
-  const Settings s = parse(p);
-  if (s.order() == 2) return std::make_unique<TrackFusion<2>>(s);
-  return std::make_unique<TrackFusion<3>>(s);
-}
+std::unique_ptr<Component> create(const Params& p) { return std::make_unique<TrackFusion>(parse(p), transition_given(p)); }
 
 void register_components(Registrar& r) {
   ComponentDecl d;
@@ -285,9 +335,10 @@ void register_components(Registrar& r) {
       "update's new information Y_i(k|k) - Y_i(k|k-1), the local prediction being formed here from that input's "
       "previous estimate, so the process noise the local tracks share is counted once. method independent: "
       "P^-1 = P1^-1 + P2^-1, the fusion that ignores the cross-covariance (overconfident when the local errors are "
-      "correlated, as they are through the common process noise; a baseline). All three need the local filters' "
-      "motion and noise: give the same motion and q / q_jerk / sigma_accel / singer_* here (the state sizes are "
-      "checked). The summary gives fused estimates, fused-track restarts and, for CI, the mean weight of the first "
+      "correlated, as they are through the common process noise; a baseline). All three predict with the local "
+      "filters' transition model, which the node takes from its inputs (every input naming one must name the same); "
+      "motion and q / q_jerk / sigma_accel / singer_* given here must agree with it, and are needed only when no "
+      "input names its model. The summary gives fused estimates, fused-track restarts and, for CI, the mean weight of the first "
       "input. See docs/filters.md, Track-to-track fusion.";
   d.accepts = mask(ItemKind::Estimate);
   d.min_inputs = 2;
@@ -309,8 +360,9 @@ void register_components(Registrar& r) {
                                              "trace or its determinant")
           .def("trace"),
   };
-  // The local filters' motion and noise, declared as theirs (the same words in the same units).
-  for (ParamSpec& spec : cartesian_filter::motion_param_specs()) d.params.push_back(std::move(spec));
+  // The local filters' motion and noise, declared as theirs (the same words in the same units):
+  // left out, the node takes its inputs' model (InputInfo::transition).
+  for (ParamSpec& spec : transition_param_specs()) d.params.push_back(std::move(spec));
   d.create = create;
   r.add(std::move(d));
 }

@@ -166,31 +166,35 @@ class UnscentedKalmanFilter final
   double max_jitter_ = 0.0;
 };
 
-template <class Make>
-auto make(const Params& p, Make&& make_one) {
-  const cartesian_filter::Settings s = cartesian_filter::parse_settings(p, "filter.ukf");
-  const int n = s.state_dim();
+// The node's parameters: the Cartesian filters' settings and the sigma-point scaling.
+struct UkfParams {
+  cartesian_filter::Settings s;
   UnscentedSettings u;
-  u.alpha = p.real("alpha");
-  u.beta = p.real("beta");
-  u.kappa = p.real_or("kappa", 3.0 - n);
-  if (!(n + u.kappa > 0.0))
+};
+
+UkfParams parse(const Params& p) {
+  UkfParams k{cartesian_filter::parse_settings(p, "filter.ukf"), {}};
+  const int n = k.s.state_dim();
+  k.u.alpha = p.real("alpha");
+  k.u.beta = p.real("beta");
+  k.u.kappa = p.real_or("kappa", 3.0 - n);
+  if (!(n + k.u.kappa > 0.0))
     throw p.error("kappa", "kappa must exceed -n = " + std::to_string(-n) + " (the state has n = " +
                                std::to_string(n) + " elements): the sigma points lie at sqrt(alpha^2 (n + kappa)) "
                                "standard deviations");
-  return s.order() == 2 ? make_one(UnscentedKalmanFilter<2>(s, u), s) : make_one(UnscentedKalmanFilter<3>(s, u), s);
+  return k;
 }
 
 std::unique_ptr<Component> create(const Params& p) {
-  return make(p, [](auto e, const cartesian_filter::Settings& s) -> std::unique_ptr<Component> {
-    return make_single_track_filter(s.type, s.node, std::move(e));
-  });
+  const UkfParams k = parse(p);
+  if (k.s.order() == 2) return make_single_track_filter(k.s.type, k.s.node, UnscentedKalmanFilter<2>(k.s, k.u));
+  return make_single_track_filter(k.s.type, k.s.node, UnscentedKalmanFilter<3>(k.s, k.u));
 }
 
 std::unique_ptr<Estimator> create_estimator(const Params& p) {
-  return make(p, [](auto e, const cartesian_filter::Settings&) -> std::unique_ptr<Estimator> {
-    return std::make_unique<decltype(e)>(std::move(e));
-  });
+  const UkfParams k = parse(p);
+  if (k.s.order() == 2) return std::make_unique<UnscentedKalmanFilter<2>>(k.s, k.u);
+  return std::make_unique<UnscentedKalmanFilter<3>>(k.s, k.u);
 }
 
 void register_components(Registrar& r) {

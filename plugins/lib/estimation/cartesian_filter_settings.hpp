@@ -1,9 +1,10 @@
-// Purpose: settings of the Cartesian-state radar filters (filter.ekf, filter.ukf; the motion block also filter.imm's modes and filter.track_fusion) — motion and noise model, range-rate use, initialisation — with their parameter declarations and parsing.
+// Purpose: settings of the Cartesian-state radar filters (filter.ekf, filter.ukf, filter.imm's record modes) — the transition model (trackflow/transition_model.hpp), range-rate use, initialisation — with their parameter declarations and parsing.
 #pragma once
 
 #include <trackflow/common_params.hpp>
 #include <trackflow/items.hpp>
 #include <trackflow/params.hpp>
+#include <trackflow/transition_model.hpp>
 #include <trackflow/units.hpp>
 
 #include <string>
@@ -11,20 +12,7 @@
 
 namespace trackflow::cartesian_filter {
 
-// The motion and noise model the motion parameters give (motion_param_specs, parse_motion): every
-// Cartesian radar filter's, each mode of filter.imm's, and filter.track_fusion's model of its inputs.
-struct MotionModel {
-  enum class Motion { ConstantVelocity, ConstantAcceleration, Singer } motion = Motion::ConstantVelocity;
-  // Continuous: q (CV, m2/s3) or q_jerk (CA, m2/s5); Discrete: sigma_accel; Singer: singer_sigma.
-  enum class Noise { Continuous, Discrete, Singer } noise = Noise::Continuous;
-  double intensity = 1.0;
-  double singer_alpha = 1.0;
-
-  int order() const { return motion == Motion::ConstantVelocity ? 2 : 3; }  // states per axis
-  int state_dim() const { return 3 * order(); }
-};
-
-struct Settings : MotionModel {
+struct Settings : TransitionModel {
   RangeRateUse range_rate = RangeRateUse::Auto;
   enum class Init { TwoPoint, Explicit, Paper000 } init = Init::TwoPoint;
   // Near the zenith: add the angles' curvature variance to R and drop the azimuth while the
@@ -35,33 +23,6 @@ struct Settings : MotionModel {
   std::string type;                  // component type, for messages ("filter.ekf")
   std::string node;
 };
-
-// Motion and noise parameters, declared once: every Cartesian radar filter's, each mode of
-// filter.imm's and filter.track_fusion's (the model of its inputs).
-inline std::vector<ParamSpec> motion_param_specs() {
-  return {
-      ParamSpec::choice<Settings::Motion>("motion",
-                                          {{Settings::Motion::ConstantVelocity, "constant_velocity"},
-                                           {Settings::Motion::ConstantAcceleration, "constant_acceleration"},
-                                           {Settings::Motion::Singer, "singer"}},
-                                          "motion model")
-          .def("constant_velocity"),
-      ParamSpec::real("q", dim::accel_psd, "constant_velocity: spectral density of the white acceleration noise")
-          .def("1 m2/s3")
-          .at_least(0),
-      ParamSpec::real("q_jerk", dim::jerk_psd,
-                      "constant_acceleration: spectral density of the white jerk noise (paper 000 eq 3.19)")
-          .def("1 m2/s5")
-          .at_least(0),
-      ParamSpec::real("sigma_accel", dim::acceleration,
-                      "CV/CA discrete white-noise model instead: std of the acceleration (CV) or its increment (CA)")
-          .at_least(0),
-      ParamSpec::real("singer_alpha", dim::frequency, "singer: inverse correlation time of the acceleration, e.g. 1/s")
-          .positive(),
-      ParamSpec::real("singer_sigma", dim::acceleration, "singer: standard deviation sigma_m of the acceleration")
-          .positive(),
-  };
-}
 
 inline ParamSpec zenith_param() {
   using Zenith = Settings::Zenith;
@@ -79,7 +40,7 @@ inline ParamSpec initial_sigma_acceleration_param() {
 
 // Motion, noise, range-rate and initialisation parameters every Cartesian radar filter takes.
 inline std::vector<ParamSpec> param_specs() {
-  std::vector<ParamSpec> specs = motion_param_specs();
+  std::vector<ParamSpec> specs = transition_param_specs();
   for (ParamSpec& p : std::vector<ParamSpec>{
       range_rate_param(),
       ParamSpec::choice<Settings::Init>("init",
@@ -100,45 +61,13 @@ inline std::vector<ParamSpec> param_specs() {
   return specs;
 }
 
-// Validates the combination of motion_param_specs() (each one alone was checked by its ParamSpec)
-// and sets the motion and noise of `s`.
-inline void parse_motion(const Params& p, MotionModel& s) {
-  using S = MotionModel;
-  s.motion = p.choice<S::Motion>("motion");
-  const bool cv = s.motion == S::Motion::ConstantVelocity, ca = s.motion == S::Motion::ConstantAcceleration,
-             singer = s.motion == S::Motion::Singer;
-  if (!cv && p.given("q"))
-    throw p.error("q", "q (m2/s3) is the constant_velocity intensity; constant_acceleration takes q_jerk (m2/s5), "
-                       "singer takes singer_alpha and singer_sigma");
-  if (!ca && p.given("q_jerk")) throw p.error("q_jerk", "q_jerk is for motion: constant_acceleration");
-  if (singer && p.given("sigma_accel"))
-    throw p.error("sigma_accel", "sigma_accel is the discrete-noise alternative for constant_velocity and "
-                                 "constant_acceleration; the Singer noise is set by singer_sigma");
-  for (const char* name : {"singer_alpha", "singer_sigma"}) {
-    if (!singer && p.given(name)) throw p.error(name, std::string(name) + " is for motion: singer");
-    if (singer && !p.has(name)) throw p.error(name, "required with motion: singer");
-  }
-  if (p.given("sigma_accel") && (p.given("q") || p.given("q_jerk")))
-    throw p.error("sigma_accel", "give either a continuous-noise intensity (q / q_jerk) or sigma_accel, not both");
-  if (singer) {
-    s.noise = S::Noise::Singer;
-    s.intensity = p.real("singer_sigma");
-    s.singer_alpha = p.real("singer_alpha");
-  } else if (p.given("sigma_accel")) {
-    s.noise = S::Noise::Discrete;
-    s.intensity = p.real("sigma_accel");
-  } else {
-    s.intensity = ca ? p.real("q_jerk") : p.real("q");
-  }
-}
-
 // Validates the combination of the parameters of param_specs().
 inline Settings parse_settings(const Params& p, std::string type) {
   using S = Settings;
   S s;
   s.type = std::move(type);
   s.node = p.node();
-  parse_motion(p, s);
+  static_cast<TransitionModel&>(s) = parse_transition(p);
   const bool cv = s.motion == S::Motion::ConstantVelocity, singer = s.motion == S::Motion::Singer;
 
   s.range_rate = p.choice<RangeRateUse>("range_rate");

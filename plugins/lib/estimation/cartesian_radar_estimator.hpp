@@ -56,6 +56,7 @@ class CartesianRadarEstimator : public Estimator, protected CartesianRadarState<
   }
 
   StateLayout layout() const override { return Layout::state_layout(); }
+  const TransitionModel* transition_model() const override { return &this->s_; }
   std::unique_ptr<Estimator> clone() const override { return std::make_unique<Derived>(derived()); }
 
   bool reset() override {
