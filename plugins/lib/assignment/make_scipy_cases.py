@@ -6,13 +6,16 @@
 # arithmetic and exact conversions (53-bit integer times a power of two) leave no room for the
 # two languages to differ. So the data file holds only each case's recipe and SciPy's answer.
 #
-# Run from this folder with Debian's python3-scipy:  /usr/bin/python3 make_scipy_cases.py
+# Write:  /usr/bin/python3 make_scipy_cases.py          (Debian's python3-scipy)
+# Check:  /usr/bin/python3 make_scipy_cases.py --check  (ctest "assignment: SciPy still gives
+#         data/scipy_cases.txt": every case's feasibility and total as SciPy solves it today, to
+#         1e-9 relative, so a SciPy version that breaks ties differently still passes; exit 77,
+#         a ctest skip, when numpy or SciPy is missing)
 import math
 import os
 import sys
 
-import numpy as np
-from scipy.optimize import linear_sum_assignment
+SKIP = 77
 
 MASK = (1 << 64) - 1
 
@@ -56,6 +59,8 @@ CASES = [
 def matrix(rows, cols, seed, int_range, forbid_per_mille, hall):
     """Row-major, one cost draw then one forbid draw per entry (scipy_case_matrix.hpp)."""
     rng = SplitMix64(seed)
+    import numpy as np
+
     m = np.empty((rows, cols))
     for i in range(rows):
         for j in range(cols):
@@ -67,27 +72,75 @@ def matrix(rows, cols, seed, int_range, forbid_per_mille, hall):
     return m
 
 
-def main():
-    here = os.path.dirname(os.path.abspath(__file__))
-    lines = ["# Written by make_scipy_cases.py with SciPy " + __import__("scipy").__version__ + "; do not edit.",
+def solve(name, rows, cols, seed, int_range, forbid, hall):
+    """(feasible, total, column_for_row) as SciPy's linear_sum_assignment gives them."""
+    from scipy.optimize import linear_sum_assignment
+
+    m = matrix(rows, cols, seed, int_range, forbid, hall)
+    try:
+        r, c = linear_sum_assignment(m)
+    except ValueError:  # SciPy: "cost matrix is infeasible"
+        return False, math.inf, []
+    column_for_row = [-1] * rows
+    for i, j in zip(r, c):
+        column_for_row[i] = int(j)
+    return True, float(m[r, c].sum()), column_for_row
+
+
+def data_path():
+    return os.path.join(os.path.dirname(os.path.abspath(__file__)), "data", "scipy_cases.txt")
+
+
+def write():
+    import scipy
+
+    lines = ["# Written by make_scipy_cases.py with SciPy " + scipy.__version__ + "; do not edit.",
              "# name rows cols seed int_range forbid_per_mille hall feasible total(hex) column_for_row..."]
-    for name, rows, cols, seed, int_range, forbid, hall in CASES:
-        m = matrix(rows, cols, seed, int_range, forbid, hall)
-        head = f"{name} {rows} {cols} {seed} {int_range} {forbid} {hall}"
-        try:
-            r, c = linear_sum_assignment(m)
-        except ValueError as e:  # SciPy: "cost matrix is infeasible"
-            lines.append(f"{head} 0 inf")
-            print(f"{name}: infeasible ({e})")
-            continue
-        column_for_row = [-1] * rows
-        for i, j in zip(r, c):
-            column_for_row[i] = int(j)
-        total = float(m[r, c].sum())
-        lines.append(f"{head} 1 {total.hex()} " + " ".join(map(str, column_for_row)))
-        print(f"{name}: total {total}")
-    with open(os.path.join(here, "data", "scipy_cases.txt"), "w") as f:
+    for case in CASES:
+        feasible, total, column_for_row = solve(*case)
+        head = " ".join(map(str, case))
+        lines.append(f"{head} 1 {total.hex()} " + " ".join(map(str, column_for_row)) if feasible else f"{head} 0 inf")
+        print(f"{case[0]}: " + (f"total {total}" if feasible else "infeasible"))
+    with open(data_path(), "w") as f:
         f.write("\n".join(lines) + "\n")
+    return 0
+
+
+def check():
+    committed = {}
+    with open(data_path()) as f:
+        for line in f:
+            if line.startswith("#") or not line.strip():
+                continue
+            fields = line.split()
+            committed[fields[0]] = (fields[7] == "1", float.fromhex(fields[8]) if fields[7] == "1" else math.inf)
+    failures = 0
+    for case in CASES:
+        name = case[0]
+        feasible, total, _ = solve(*case)
+        if name not in committed:
+            print(f"FAIL: {name} is not in {data_path()}: rerun make_scipy_cases.py")
+            failures += 1
+            continue
+        want_feasible, want_total = committed[name]
+        ok = feasible == want_feasible and (not feasible or abs(total - want_total) <= 1e-9 * max(1.0, abs(want_total)))
+        print(("ok" if ok else "FAIL") + f": {name}: SciPy today {feasible} {total}, committed {want_feasible} {want_total}")
+        failures += 0 if ok else 1
+    if len(committed) != len(CASES):
+        print(f"FAIL: {len(committed)} committed cases, {len(CASES)} in CASES")
+        failures += 1
+    print(f"{len(CASES)} cases solved by SciPy and compared, {failures} failures")
+    return 1 if failures else 0
+
+
+def main():
+    try:
+        import numpy  # noqa: F401
+        import scipy.optimize  # noqa: F401
+    except ImportError as e:
+        print(f"skipped: {e} (Debian: apt-get install python3-scipy)")
+        return SKIP if "--check" in sys.argv[1:] else 1
+    return check() if "--check" in sys.argv[1:] else write()
 
 
 if __name__ == "__main__":
