@@ -2,6 +2,7 @@
 #include "assignment/linear_assignment.hpp"
 
 #include "brute_force_assignment.hpp"
+#include "one_to_one_check.hpp"
 #include "scipy_case_matrix.hpp"
 
 #include <catch2/catch.hpp>
@@ -20,6 +21,7 @@
 using trackflow::assignment::AssignmentResult;
 using trackflow::assignment::LinearAssignment;
 using trackflow::assignment::test::BruteForceAssignment;
+using trackflow::assignment::test::require_one_to_one;
 using trackflow::assignment::test::scipy_case_matrix;
 using trackflow::assignment::test::ScipyCaseRecipe;
 
@@ -31,24 +33,18 @@ double cost_at(const std::vector<double>& cost, int cols, int i, int j) {
   return cost[static_cast<std::size_t>(i) * static_cast<std::size_t>(cols) + static_cast<std::size_t>(j)];
 }
 
-// A returned assignment must be one-to-one, cover the smaller side, use finite entries only, and
-// cost what the solver says it costs. Returns that recomputed cost.
+// A returned assignment must be one-to-one, cover the smaller side and use finite entries only.
+// Returns what it costs, for the caller to compare with the reported total.
 double check_assignment(const AssignmentResult& r, const std::vector<double>& cost, int rows, int cols) {
   REQUIRE(r.column_for_row.size() == static_cast<std::size_t>(rows));
-  std::vector<int> row_for_column(static_cast<std::size_t>(cols), -1);
-  int assigned = 0;
+  REQUIRE(require_one_to_one(r.column_for_row, cols) == std::min(rows, cols));
   double sum = 0.0;
   for (int i = 0; i < rows; ++i) {
     const int j = r.column_for_row[static_cast<std::size_t>(i)];
     if (j < 0) continue;
-    REQUIRE(j < cols);
-    REQUIRE(row_for_column[static_cast<std::size_t>(j)] == -1);
-    row_for_column[static_cast<std::size_t>(j)] = i;
     REQUIRE(std::isfinite(cost_at(cost, cols, i, j)));
     sum += cost_at(cost, cols, i, j);
-    ++assigned;
   }
-  REQUIRE(assigned == std::min(rows, cols));
   return sum;
 }
 

@@ -1,6 +1,7 @@
 // Purpose: Gospa against enumeration of both of GOSPA's definitions, hand-worked sets and bad parameters.
 #include "scoring/gospa.hpp"
 
+#include "assignment/one_to_one_check.hpp"
 #include "gospa_brute_force.hpp"
 
 #include <catch2/catch.hpp>
@@ -12,6 +13,7 @@
 #include <random>
 #include <vector>
 
+using trackflow::assignment::test::require_one_to_one;
 using trackflow::metrics::Gospa;
 using trackflow::metrics::GospaResult;
 using trackflow::metrics::test::InjectionGospa;
@@ -71,19 +73,15 @@ void check_against_enumeration(std::mt19937_64& rng, Coverage& coverage) {
   REQUIRE(close(swapped.evaluate(tracks, truth).gospa_pow_p, r.gospa_pow_p));
 
   // The reported pairs: distinct tracks, each closer than c.
-  std::vector<bool> used(static_cast<std::size_t>(ny), false);
+  REQUIRE(r.track_for_truth.size() == static_cast<std::size_t>(nx));
+  const int detected = require_one_to_one(r.track_for_truth, ny);
   double localisation = 0.0;
-  int detected = 0;
   for (int i = 0; i < nx; ++i) {
     const int j = r.track_for_truth[static_cast<std::size_t>(i)];
     if (j < 0) continue;
-    REQUIRE(j < ny);
-    REQUIRE_FALSE(used[static_cast<std::size_t>(j)]);
-    used[static_cast<std::size_t>(j)] = true;
     const double d = (truth[static_cast<std::size_t>(i)] - tracks[static_cast<std::size_t>(j)]).norm();
     REQUIRE(d < c);
     localisation += std::pow(d, p);
-    ++detected;
   }
   coverage.clipped_pairs += std::min(nx, ny) - detected;
 
