@@ -37,9 +37,10 @@ struct AssignmentResult {
 // free column; the duals are then updated so that every edge of the new matching stays tight,
 // and the path is flipped. n rows cost O(n^2 m) in all.
 //
-// Costs: +infinity forbids a pairing. NaN and -infinity are refused with std::invalid_argument
-// (NaN has no order; -infinity makes the minimum unbounded). Finite costs should stay well inside
-// the double range (|c| < 1e300, say): reduced costs are differences of sums of costs.
+// Costs: +infinity forbids a pairing. NaN, -infinity and finite costs of magnitude above 1e300
+// are refused with std::invalid_argument: NaN has no order, -infinity makes the minimum
+// unbounded, and reduced costs are sums and differences of costs that must not overflow to an
+// infinity (which would read as "forbidden") or to NaN.
 //
 // Ties: the search is a fixed sequence of comparisons over the input, so the same matrix always
 // gives the same assignment; among equally short paths the first found column wins, a free one
@@ -91,6 +92,7 @@ class LinearAssignment {
 
  private:
   static constexpr double kInf = std::numeric_limits<double>::infinity();
+  static constexpr double kLargestCost = 1e300;
 
   static void check_size(long long rows, long long cols) {
     if (rows < 0 || cols < 0)
@@ -153,10 +155,10 @@ class LinearAssignment {
     for (int i = 0; i < rows; ++i)
       for (int j = 0; j < cols; ++j) {
         const double c = data[i * row_stride + j * col_stride];
-        if (std::isnan(c) || c == -kInf)
-          throw std::invalid_argument("linear assignment: cost(" + std::to_string(i) + ", " + std::to_string(j) +
-                                      ") is " + (std::isnan(c) ? "NaN" : "-infinity") +
-                                      "; costs must be finite or +infinity (forbidden)");
+        if (c == kInf || std::abs(c) <= kLargestCost) continue;
+        const std::string what = std::isnan(c) ? "NaN" : c == -kInf ? "-infinity" : std::to_string(c);
+        throw std::invalid_argument("linear assignment: cost(" + std::to_string(i) + ", " + std::to_string(j) +
+                                    ") is " + what + "; costs must be within +-1e300 or +infinity (forbidden)");
       }
   }
 

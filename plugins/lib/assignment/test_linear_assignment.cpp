@@ -291,6 +291,8 @@ TEST_CASE("bad input is refused with a clear exception", "[assignment]") {
   const double nan = std::numeric_limits<double>::quiet_NaN();
   CHECK_THROWS_WITH(solver.solve(std::vector<double>{1, nan, 2, 3}, 2, 2), Catch::Contains("is NaN"));
   CHECK_THROWS_WITH(solver.solve(std::vector<double>{1, 2, -kInf, 3}, 2, 2), Catch::Contains("-infinity"));
+  CHECK_THROWS_WITH(solver.solve(std::vector<double>{1, 2, 3, -1e301}, 2, 2), Catch::Contains("cost(1, 1) is -"));
+  CHECK(solver.solve(std::vector<double>{1e300, -1e300, -1e300, 1e300}, 2, 2).total_cost == -2e300);
   CHECK_THROWS_WITH(solver.solve(std::vector<double>{1, 2}, -1, 2), Catch::Contains("negative size"));
   CHECK_THROWS_WITH(solver.reserve(3, -2), Catch::Contains("negative size"));
   CHECK_THROWS_WITH(solver.solve(std::vector<double>{1, 2, 3}, 2, 2), Catch::Contains("not 2 x 2"));
