@@ -47,8 +47,9 @@ struct AssignmentResult {
 // before an assigned one (which ends the search earlier).
 //
 // Storage: the work arrays are members. After reserve(rows, cols) a solve of a problem no larger
-// (in rows * cols terms: min and max side each within the reserved ones) allocates nothing; a
-// larger one grows them once.
+// (smaller side and larger side each within the reserved ones) allocates nothing; a larger one
+// grows them once. A matrix that is not laid out along the larger side (rows > cols row-major,
+// or a column-major Eigen matrix with rows <= cols) is copied once into that layout.
 class LinearAssignment {
  public:
   LinearAssignment() = default;
@@ -69,6 +70,7 @@ class LinearAssignment {
     unvisited_large_.reserve(large);
     visited_large_.reserve(large);
     column_for_row_.reserve(all);
+    contiguous_.reserve(static_cast<std::size_t>(rows) * static_cast<std::size_t>(cols));
   }
 
   // Row-major: cost(i, j) = cost[i * cols + j].
@@ -81,7 +83,7 @@ class LinearAssignment {
   }
 
   // Any Eigen matrix expression with direct access (column-major MatrixXd, a row-major map, a
-  // block): its strides are used as they are, nothing is copied.
+  // block), read through its strides.
   template <typename Derived>
   AssignmentResult solve(const Eigen::DenseBase<Derived>& cost) {
     const Derived& m = cost.derived();
@@ -102,17 +104,28 @@ class LinearAssignment {
       throw std::invalid_argument("linear assignment: size beyond int range");
   }
 
-  // cost(i, j) = data[i * row_stride + j * col_stride]. The search always runs over the smaller
-  // side as "rows" of the algorithm; for rows > cols the strides are swapped instead of copying
-  // a transposed matrix.
+  // cost(i, j) = data[i * row_stride + j * col_stride]. The search always runs from the smaller
+  // side ("small": the rows, or the columns when rows > cols) over the larger one.
   AssignmentResult solve_strided(const double* data, int rows, int cols, std::ptrdiff_t row_stride,
                                  std::ptrdiff_t col_stride) {
     check_entries(data, rows, cols, row_stride, col_stride);
     const bool transposed = rows > cols;
     const int small = transposed ? cols : rows;
     const int large = transposed ? rows : cols;
-    const std::ptrdiff_t small_stride = transposed ? col_stride : row_stride;
-    const std::ptrdiff_t large_stride = transposed ? row_stride : col_stride;
+    std::ptrdiff_t small_stride = transposed ? col_stride : row_stride;
+    std::ptrdiff_t large_stride = transposed ? row_stride : col_stride;
+    if (large_stride != 1 && small > 0) {
+      // The search reads one small-side line at a time along the large side: lay the matrix out
+      // that way once (O(nm) against the search's O(n^2 m)) rather than stride through memory.
+      contiguous_.resize(static_cast<std::size_t>(small) * static_cast<std::size_t>(large));
+      for (int a = 0; a < small; ++a)
+        for (int b = 0; b < large; ++b)
+          contiguous_[static_cast<std::size_t>(a) * static_cast<std::size_t>(large) + static_cast<std::size_t>(b)] =
+              data[a * small_stride + b * large_stride];
+      data = contiguous_.data();
+      small_stride = large;
+      large_stride = 1;
+    }
 
     column_for_row_.assign(static_cast<std::size_t>(rows), -1);
     if (small == 0) return {true, 0.0, column_for_row_};
@@ -250,6 +263,7 @@ class LinearAssignment {
   std::vector<int> unvisited_large_;
   std::vector<char> visited_large_;
   std::vector<int> column_for_row_;
+  std::vector<double> contiguous_;  // the costs small-side-major, when the input is not already
 };
 
 }  // namespace trackflow::assignment
