@@ -144,7 +144,8 @@ class LinearAssignment {
       const int sink = shortest_augmenting_path(data, start, large, small_stride, large_stride);
       if (sink < 0) {
         // No alternating path of finite cost reaches a free column, so no assignment covers the
-        // rows 0..start together (the symmetric difference with one would contain such a path).
+        // small-side lines 0..start together (its symmetric difference with the current matching
+        // would contain such a path).
         column_for_row_.assign(static_cast<std::size_t>(rows), -1);
         return {false, kInf, column_for_row_};
       }
