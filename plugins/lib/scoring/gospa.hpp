@@ -38,7 +38,8 @@ struct GospaResult {
 };
 
 // GOSPA of A. S. Rahmathullah, A. F. Garcia-Fernandez and L. Svensson, "Generalized optimal
-// sub-pattern assignment metric", FUSION 2017 (arXiv:1601.05585; equation numbers of arXiv v7).
+// sub-pattern assignment metric", FUSION 2017 (arXiv:1601.05585; equation numbers of arXiv v7,
+// not yet checked against the PDF: docs/assignment.md).
 // X: truth positions, Y: track positions, d(x, y) the Euclidean distance, d^(c) = min(d, c).
 //
 //   Definition 1, Eq. (1), |X| <= |Y|:
