@@ -30,7 +30,7 @@ struct AssignmentResult {
 //
 // Algorithm: the shortest augmenting path method of Jonker and Volgenant in the rectangular form
 // of D. F. Crouse, "On implementing 2D rectangular assignment algorithms", IEEE Trans. Aerospace
-// and Electronic Systems 52(4):1679-1696, 2016, Sec. III-B and the pseudocode of pp. 1685-1686
+// and Electronic Systems 52(4):1679-1696, 2016, the pseudocode of pp. 1685-1686
 // (the algorithm of SciPy's linear_sum_assignment). Each row of the smaller side is added in
 // turn: a Dijkstra search over reduced costs c(i,j) - u(i) - v(j) (non-negative by the dual
 // feasibility the method maintains) finds the cheapest alternating path from the new row to a
@@ -223,7 +223,7 @@ class LinearAssignment {
         s = small_for_large_[static_cast<std::size_t>(l)];
     }
 
-    // Dual update (Crouse, Sec. III-B): rows and columns settled before the sink move by how much
+    // Dual update (Crouse, pp. 1685-1686): rows and columns settled before the sink move by how much
     // shorter their path was than the sink's, which keeps reduced costs >= 0 and makes the
     // augmenting path tight.
     dual_small_[static_cast<std::size_t>(start)] += settled;

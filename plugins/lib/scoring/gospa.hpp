@@ -51,7 +51,7 @@ struct GospaResult {
 //   costs c^p either way, as a clipped pair or as one missed plus one false target.
 //
 // OSPA of D. Schuhmacher, B.-T. Vo and B.-N. Vo, "A consistent metric for performance evaluation
-// of multi-object filters", IEEE Trans. Signal Processing 56(8), 2008, Sec. III, m <= n:
+// of multi-object filters", IEEE Trans. Signal Processing 56(8), 2008, m <= n:
 //     d_p^(c)(X, Y) = ( (min_pi sum_{i=1}^m d^(c)(x_i, y_pi(i))^p + c^p (n - m)) / n )^(1/p)
 // The minimising pi is the one GOSPA's Eq. (1) needs (the penalty term does not depend on pi),
 // so one assignment gives both.
