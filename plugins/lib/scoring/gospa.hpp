@@ -15,7 +15,7 @@
 
 namespace trackflow::metrics {
 
-// For alpha = 2 only: the p-th power of GOSPA split into what the paper's Sec. IV calls
+// For alpha = 2 only: the p-th power of GOSPA split into what the paper calls
 // localisation error of properly detected targets, and the costs of missed and false targets.
 // localisation + missed + false == GospaResult::gospa_pow_p (up to rounding).
 struct GospaDecomposition {
