@@ -26,8 +26,10 @@ case "$mode" in
   test | sanitize)
     # The headless-browser test of the report (tests/report/browser.sh) and a font for its
     # screenshot; clang++ and libFuzzer for the fuzz harnesses (tests/fuzz) and the clang build of
-    # the SDK. Benchmarks are not built for tests (and mean nothing under ASan).
-    packages+=(chromium fonts-dejavu-core clang libfuzzer-14-dev)
+    # the SDK; SciPy for the check that the assignment solver's committed SciPy answers are still
+    # SciPy's (plugins/lib/assignment/make_scipy_cases.py --check). Benchmarks are not built for
+    # tests (and mean nothing under ASan).
+    packages+=(chromium fonts-dejavu-core clang libfuzzer-14-dev python3-scipy)
     options=(-DTRACKFLOW_BUILD_TESTS=ON -DTRACKFLOW_BUILD_BENCH=OFF)
     ;;
   bench)
