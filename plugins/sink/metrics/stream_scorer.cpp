@@ -107,7 +107,7 @@ void StreamScorer::commit(const Estimate& e) {
     ++r.before_window;
     return;
   }
-  if (!e.enu.allFinite()) {
+  if (!all_finite(e.enu)) {
     ++r.non_finite;
     return;
   }

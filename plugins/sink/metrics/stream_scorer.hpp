@@ -70,6 +70,9 @@ class StreamScorer {
  private:
   static constexpr double kInf = std::numeric_limits<double>::infinity();
   struct PendingEstimate {
+    // Filled in place by commit(): a user-provided constructor, so that Fifo::push's emplace_back()
+    // does not zero its 46 words first (value-initialisation would).
+    PendingEstimate() {}
     std::size_t record;
     double time;
     std::uint32_t target;
