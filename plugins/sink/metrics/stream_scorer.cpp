@@ -36,6 +36,9 @@ void StreamScorer::start_run() {
   }
   run_ = std::make_unique<MetricsRunResult>();
   if (!opt_.sums_only) run_->records.reserve(records_reserve_);
+  // The series' measurement records likewise: grown from empty in every run, they were the hot
+  // path's only allocations (and copies) after the first run.
+  if (opt_.series) run_->measurement_records.reserve(measurement_records_reserve_);
   truth_.clear();
   latest_truth_ = -kInf;
   truth_seen_ = truth_unordered_ = false;
@@ -314,6 +317,7 @@ std::unique_ptr<MetricsRunResult> StreamScorer::end_run() {
   }
   r.had_truth = truth_seen_;
   records_reserve_ = r.records.size();  // runs are usually of one length
+  measurement_records_reserve_ = r.measurement_records.size();
   return std::move(run_);
 }
 

@@ -105,6 +105,7 @@ class StreamScorer {
   const AnnotationChannels* channels_ = nullptr;
   std::unique_ptr<MetricsRunResult> run_;
   std::size_t records_reserve_ = 1024;  // the previous run's record count
+  std::size_t measurement_records_reserve_ = 1024;  // and measurement record count (series)
   std::uint64_t run_count_ = 0;
 
   // Truth of the run, sorted as insert_truth keeps it; with one target, only from what a lookup
