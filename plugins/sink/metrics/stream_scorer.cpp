@@ -95,7 +95,7 @@ void StreamScorer::commit(const Estimate& e) {
     if (e.initialised) ++r.non_finite;
     return;
   }
-  const long long key = std::llround(e.time / opt_.tolerance);
+  const long long key = round_key(e.time / opt_.tolerance);
   EstimateRecord* rec = nullptr;
   if (!opt_.sums_only) {
     rec = &r.records.emplace_back();
