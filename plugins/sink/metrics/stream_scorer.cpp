@@ -181,7 +181,8 @@ StreamScorer::Lookup StreamScorer::lookup(std::uint32_t target, bool measurement
     for (const Truth* q = it + 1; q != span.end && q->time <= hi; ++q) best = std::min(best, std::abs(q->time - t));
     if (!(latest_truth_ - t >= best)) return Lookup::Wait;
   }
-  return truth_at(span, t, opt_.tolerance, state, from) ? Lookup::Matched : Lookup::Unmatched;  // starts at `it`
+  // `it` is where truth_at (from `cursor`) would start: its answer from there, without its search.
+  return truth_from(span, it, t, opt_.tolerance, state) ? Lookup::Matched : Lookup::Unmatched;
 }
 
 void StreamScorer::on_measurement(double time, const Vec3& position) {
