@@ -17,7 +17,10 @@ inline void score_innovation(EstimateRecord& rec, bool updated, double nis, cons
   if (updated && m > 0 && std::isfinite(nis)) {
     rec.nis_dof = m;
     rec.nis = nis;
-    rec.innovation.head(m) = innovation;
+    if (m == 3)  // the usual size, as a fixed-size copy (a run-time-sized one is a generic loop)
+      rec.innovation.head<3>() = innovation.head<3>();
+    else
+      rec.innovation.head(m) = innovation;
   }
 }
 
