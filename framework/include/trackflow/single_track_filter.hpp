@@ -280,8 +280,19 @@ class SingleTrackFilter final : public Filter, public FieldListCodec<SingleTrack
   }
   static bool finite(const Measurement& m, int dim, const MeasCov& R) {
     if (m.value.size() < dim || R.rows() < dim || R.cols() < dim) return false;
-    if (dim == 4) return m.value.template head<4>().allFinite() && R.template topLeftCorner<4, 4>().allFinite();
-    return m.value.template head<3>().allFinite() && R.template topLeftCorner<3, 3>().allFinite();
+    if (dim == 4) return finite_block<4, 1>(m.value) && finite_block<4, 4>(R);
+    return finite_block<3, 1>(m.value) && finite_block<3, 3>(R);
+  }
+  // Whether the leading Rows x Cols block of `a` is finite, element by element: x * 0 is 0 for a
+  // finite x and NaN for an infinity or a NaN, so the products sum to 0 exactly when all are
+  // finite. Straight-line code of fixed length; Eigen's allFinite() on a block of a run-time-sized
+  // item was an out-of-line generic loop (the quickstart: 320 instructions per measurement).
+  template <int Rows, int Cols, class M>
+  static bool finite_block(const M& a) {
+    double zero = 0.0;
+    for (int j = 0; j < Cols; ++j)
+      for (int i = 0; i < Rows; ++i) zero += a.coeff(i, j) * 0.0;
+    return zero == 0.0;
   }
 
   int dimension(const Measurement& m) const {
@@ -355,7 +366,28 @@ class SingleTrackFilter final : public Filter, public FieldListCodec<SingleTrack
 
   // One sum per block: NaN or infinity anywhere makes it non-finite (so does a sum beyond 1e308,
   // which is no usable state either). Cheaper than an element-wise test on the hot path.
+  // An estimator that declares its state dimension (`static constexpr int kStateDim`, the size
+  // fill() gives Estimate::state) gets the same sums over fixed-size blocks, unrolled, instead of
+  // Eigen's generic loops over the run-time-sized items (the quickstart: 250 instructions per
+  // estimate); the 3- and 4-element innovations likewise.
   static bool finite(const Estimate& e) {
+    if constexpr (requires { E::kStateDim; }) {
+      constexpr int N = E::kStateDim;
+      if (e.state.size() == N && e.covariance.rows() == N && e.covariance.cols() == N) {
+        const int m = static_cast<int>(e.innovation.size());
+        double innovation;
+        if (m == 0 && e.innovation_covariance.size() == 0)
+          innovation = 0.0;
+        else if (m == 3 && e.innovation_covariance.rows() == 3 && e.innovation_covariance.cols() == 3)
+          innovation = e.innovation.template head<3>().sum() + e.innovation_covariance.template topLeftCorner<3, 3>().sum();
+        else if (m == 4 && e.innovation_covariance.rows() == 4 && e.innovation_covariance.cols() == 4)
+          innovation = e.innovation.template head<4>().sum() + e.innovation_covariance.template topLeftCorner<4, 4>().sum();
+        else
+          innovation = e.innovation.sum() + e.innovation_covariance.sum();
+        return std::isfinite(e.state.template head<N>().sum() + e.covariance.template topLeftCorner<N, N>().sum() +
+                             e.enu.sum() + e.enu_covariance.sum() + e.nis + innovation);
+      }
+    }
     return std::isfinite(e.state.sum() + e.covariance.sum() + e.enu.sum() + e.enu_covariance.sum() + e.nis +
                          e.innovation.sum() + e.innovation_covariance.sum());
   }

@@ -35,13 +35,9 @@ class KalmanEstimator final : public Estimator {
   using MatN = typename Model::Matrix;
 
  public:
+  static constexpr int kStateDim = N;  // fill()'s state size: the node's non-finite check is fixed-size
   explicit KalmanEstimator(KalmanSettings s)
-      : Estimator(MeasurementSpec{Frame::Cartesian, RangeRateUse::Ignore, {}}), s_(std::move(s)) {
-    for (int a = 0; a < 3; ++a) {
-      idx_[a] = Model::position_index(a);
-      idx_[a + 3] = Model::velocity_index(a);
-    }
-  }
+      : Estimator(MeasurementSpec{Frame::Cartesian, RangeRateUse::Ignore, {}}), s_(std::move(s)) {}
   std::unique_ptr<Estimator> clone() const override { return std::make_unique<KalmanEstimator>(*this); }
 
   const TransitionModel* transition_model() const override { return &s_.transition; }
@@ -152,7 +148,7 @@ class KalmanEstimator final : public Estimator {
     return true;
   }
 
-  void fill(Estimate& e) const override { set_estimate_state(e, x_, P_, idx_); }
+  void fill(Estimate& e) const override { set_estimate_state(e, x_, P_, kEnuIndex); }
 
  private:
 
@@ -224,7 +220,10 @@ class KalmanEstimator final : public Estimator {
   Vec3 z1_ = Vec3::Zero();
   Mat3 R1_ = Mat3::Zero();
   double t1_ = 0.0;
-  int idx_[6] = {};
+  // State indices of [x y z vx vy vz]: compile-time constants, so fill() picks out the ENU block
+  // with fixed loads instead of loading each index (a gather of 42 entries per estimate).
+  static constexpr int kEnuIndex[6] = {Model::position_index(0), Model::position_index(1), Model::position_index(2),
+                                       Model::velocity_index(0), Model::velocity_index(1), Model::velocity_index(2)};
 };
 
 // filter.kalman's models: constant velocity or acceleration, continuous or discrete noise (no Singer).

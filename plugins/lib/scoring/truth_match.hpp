@@ -42,6 +42,24 @@ inline bool single_target(const std::vector<Truth>& samples) {
   return samples.empty() || samples.front().target == samples.back().target;
 }
 
+// truth_at's answer once `it`, the first sample at or after t - tolerance, is known (a caller
+// that has already found it need not search again).
+inline bool truth_from(TruthSpan span, const Truth* it, double t, double tolerance, Vec6& state) {
+  if (it != span.end && it->time <= t + tolerance) {
+    const Truth* best = it;
+    for (const Truth* p = it + 1; p != span.end && p->time <= t + tolerance; ++p)
+      if (std::abs(p->time - t) < std::abs(best->time - t)) best = p;
+    state << best->position, best->velocity;
+    return true;
+  }
+  if (it == span.begin || it == span.end) return false;
+  const Truth& a = *(it - 1);
+  const Truth& b = *it;
+  const double w = (t - a.time) / (b.time - a.time);
+  state << a.position + w * (b.position - a.position), a.velocity + w * (b.velocity - a.velocity);
+  return true;
+}
+
 // [position; velocity] at time t: the closest sample within `tolerance`, else linear
 // interpolation between the two samples that bracket t. False outside the span of the samples.
 //
@@ -60,19 +78,7 @@ inline bool truth_at(TruthSpan span, double t, double tolerance, Vec6& state, co
     it = std::lower_bound(span.begin, span.end, lo, [](const Truth& s, double time) { return s.time < time; });
   }
   if (from) *from = it;
-  if (it != span.end && it->time <= t + tolerance) {
-    const Truth* best = it;
-    for (const Truth* p = it + 1; p != span.end && p->time <= t + tolerance; ++p)
-      if (std::abs(p->time - t) < std::abs(best->time - t)) best = p;
-    state << best->position, best->velocity;
-    return true;
-  }
-  if (it == span.begin || it == span.end) return false;
-  const Truth& a = *(it - 1);
-  const Truth& b = *it;
-  const double w = (t - a.time) / (b.time - a.time);
-  state << a.position + w * (b.position - a.position), a.velocity + w * (b.velocity - a.velocity);
-  return true;
+  return truth_from(span, it, t, tolerance, state);
 }
 
 }  // namespace trackflow::metrics

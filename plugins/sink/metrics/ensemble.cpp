@@ -18,15 +18,20 @@ namespace {
 
 constexpr std::size_t kNoStep = static_cast<std::size_t>(-1);
 
-// Index of the step `key` in `steps`, or kNoStep. Records come in time order, so the step is
-// nearly always the previous record's (`cursor`) or the next; otherwise a binary search.
-std::size_t find_step(const StepList& steps, long long key, std::size_t cursor) {
-  const std::size_t n = steps.size();
-  if (cursor < n && steps[cursor].first == key) return cursor;
-  if (cursor + 1 < n && steps[cursor + 1].first == key) return cursor + 1;
+// The binary search of find_step, out of line: the two likely places are checked inline (twice
+// per record, every run), where a call for every record cost more than the checks.
+[[gnu::noinline]] std::size_t search_step(const StepList& steps, long long key) {
   const auto it = std::lower_bound(steps.begin(), steps.end(), key,
                                    [](const std::pair<long long, StepSums>& s, long long k) { return s.first < k; });
   return it != steps.end() && it->first == key ? static_cast<std::size_t>(it - steps.begin()) : kNoStep;
+}
+// Index of the step `key` in `steps`, or kNoStep. Records come in time order, so the step is
+// nearly always the previous record's (`cursor`) or the next; otherwise a binary search.
+inline std::size_t find_step(const StepList& steps, long long key, std::size_t cursor) {
+  const std::size_t n = steps.size();
+  if (cursor < n && steps[cursor].first == key) return cursor;
+  if (cursor + 1 < n && steps[cursor + 1].first == key) return cursor + 1;
+  return search_step(steps, key);
 }
 
 // Adds the keys in `missing` (any order, repeats allowed) as empty steps, keeping key order: one

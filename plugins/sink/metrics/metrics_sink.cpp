@@ -132,7 +132,7 @@ class MetricsSink final : public Component, public FieldListCodec<MetricsRunResu
         continue;
       }
       EstimateRecord& rec = r->records.emplace_back();
-      rec.key = std::llround(e.time / tolerance_);
+      rec.key = metrics::round_key(e.time / tolerance_);
       rec.time = e.time;
       rec.initialised = e.initialised;
       rec.updated = e.initialised && e.updated;

@@ -36,6 +36,9 @@ void StreamScorer::start_run() {
   }
   run_ = std::make_unique<MetricsRunResult>();
   if (!opt_.sums_only) run_->records.reserve(records_reserve_);
+  // The series' measurement records likewise: grown from empty in every run, they were the hot
+  // path's only allocations (and copies) after the first run.
+  if (opt_.series) run_->measurement_records.reserve(measurement_records_reserve_);
   truth_.clear();
   latest_truth_ = -kInf;
   truth_seen_ = truth_unordered_ = false;
@@ -92,7 +95,7 @@ void StreamScorer::commit(const Estimate& e) {
     if (e.initialised) ++r.non_finite;
     return;
   }
-  const long long key = std::llround(e.time / opt_.tolerance);
+  const long long key = round_key(e.time / opt_.tolerance);
   EstimateRecord* rec = nullptr;
   if (!opt_.sums_only) {
     rec = &r.records.emplace_back();
@@ -107,7 +110,7 @@ void StreamScorer::commit(const Estimate& e) {
     ++r.before_window;
     return;
   }
-  if (!e.enu.allFinite()) {
+  if (!all_finite(e.enu)) {
     ++r.non_finite;
     return;
   }
@@ -178,7 +181,8 @@ StreamScorer::Lookup StreamScorer::lookup(std::uint32_t target, bool measurement
     for (const Truth* q = it + 1; q != span.end && q->time <= hi; ++q) best = std::min(best, std::abs(q->time - t));
     if (!(latest_truth_ - t >= best)) return Lookup::Wait;
   }
-  return truth_at(span, t, opt_.tolerance, state, from) ? Lookup::Matched : Lookup::Unmatched;  // starts at `it`
+  // `it` is where truth_at (from `cursor`) would start: its answer from there, without its search.
+  return truth_from(span, it, t, opt_.tolerance, state) ? Lookup::Matched : Lookup::Unmatched;
 }
 
 void StreamScorer::on_measurement(double time, const Vec3& position) {
@@ -314,6 +318,7 @@ std::unique_ptr<MetricsRunResult> StreamScorer::end_run() {
   }
   r.had_truth = truth_seen_;
   records_reserve_ = r.records.size();  // runs are usually of one length
+  measurement_records_reserve_ = r.measurement_records.size();
   return std::move(run_);
 }
 

@@ -70,6 +70,9 @@ class StreamScorer {
  private:
   static constexpr double kInf = std::numeric_limits<double>::infinity();
   struct PendingEstimate {
+    // Filled in place by commit(): a user-provided constructor, so that Fifo::push's emplace_back()
+    // does not zero its 46 words first (value-initialisation would).
+    PendingEstimate() {}
     std::size_t record;
     double time;
     std::uint32_t target;
@@ -102,6 +105,7 @@ class StreamScorer {
   const AnnotationChannels* channels_ = nullptr;
   std::unique_ptr<MetricsRunResult> run_;
   std::size_t records_reserve_ = 1024;  // the previous run's record count
+  std::size_t measurement_records_reserve_ = 1024;  // and measurement record count (series)
   std::uint64_t run_count_ = 0;
 
   // Truth of the run, sorted as insert_truth keeps it; with one target, only from what a lookup
