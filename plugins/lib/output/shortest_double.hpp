@@ -70,7 +70,7 @@ inline void store8(char* p, std::uint64_t w) {
 
 // Decimal digits of s >= 1.
 inline int digit_count(std::uint64_t s) {
-  const int t = (std::bit_width(s) * 1233) >> 12;  // floor(log10(2) * bit width): the count or one less
+  const int t = (static_cast<int>(std::bit_width(s)) * 1233) >> 12;  // floor(log10(2) * bit width): the count or one less
   return t + 1 - (s < kPow10[t]);
 }
 
