@@ -15,9 +15,10 @@ case "$mode" in
     ;;
 esac
 
-# Building and running (MPI: Open MPI through Boost.MPI, for `mpirun -np N trackflow run`).
+# Building and running (MPI: Open MPI through Boost.MPI, for `mpirun -np N trackflow run`; {fmt},
+# header-only, for sink.csv's shortest numbers).
 packages=(g++ cmake ninja-build ccache pkg-config libeigen3-dev libboost-dev libboost-program-options-dev
-          libyaml-cpp-dev catch2 nlohmann-json3-dev libgeographiclib-dev libboost-mpi-dev openmpi-bin)
+          libyaml-cpp-dev catch2 nlohmann-json3-dev libgeographiclib-dev libboost-mpi-dev openmpi-bin libfmt-dev)
 case "$mode" in
   run)
     # Only what running needs: the library, the CLI and the plugins.
@@ -34,9 +35,9 @@ case "$mode" in
     ;;
   bench)
     # The benchmarks (docs/performance.md), with OpenCV's cv::KalmanFilter as the Kalman step's peer
-    # and {fmt} as std::to_chars' (trackflow-bench-number-format); GNU time and python3 for the
-    # memory scripts (bench/memory_hostile.sh, bench/memory_long_log.sh).
-    packages+=(libopencv-video-dev libfmt-dev time python3)
+    # ({fmt}, std::to_chars' peer in trackflow-bench-number-format, is in every mode's list); GNU
+    # time and python3 for the memory scripts (bench/memory_hostile.sh, bench/memory_long_log.sh).
+    packages+=(libopencv-video-dev time python3)
     options=(-DTRACKFLOW_BUILD_TESTS=OFF -DTRACKFLOW_BUILD_BENCH=ON)
     ;;
 esac

@@ -1,12 +1,16 @@
-// Purpose: benchmark: nanoseconds per number of the formatters sink.csv could use (snprintf, std::to_chars through number_text, and {fmt} when built with it) on a million tracking-sized doubles, and whether their texts agree.
+// Purpose: benchmark: nanoseconds per number of the formatters sink.csv could use (snprintf, std::to_chars through number_text, sink.csv's output::write_shortest, and {fmt}'s front end when built with it) on a million tracking-sized doubles, and whether their texts agree.
 //
 // Usage: trackflow-bench-number-format [--rounds R]
 // The values: positions of a few km to tens of km, velocities of tens to hundreds of m/s, sigmas
 // and NIS values spread over decades, all full-precision doubles as a filter writes them. The
 // contenders take turns, best of R rounds (default 7) of CPU time each. Agreement: {fmt}'s
 // "{:.10g}" against std::to_chars' (= snprintf's) "%.10g", {fmt}'s "{}" against to_chars' shortest
-// (where they differ, e.g. in the exponent or in choosing fixed or scientific notation: counted).
+// (where they differ, e.g. in the exponent or in choosing fixed or scientific notation: counted);
+// output::write_shortest (plugins/lib/output: Dragonbox digits, std::to_chars' layout) against
+// to_chars' shortest (must be 0).
 #include "bench_common.hpp"
+
+#include "output/shortest_double.hpp"
 
 #include <trackflow/number_text.hpp>
 
@@ -58,6 +62,7 @@ int main(int argc, char** argv) {
       {"snprintf \"%.10g\"", [](char* p, double v) { return p + std::snprintf(p, 64, "%.10g", v); }},
       {"std::to_chars precision 10 (write_general)", [](char* p, double v) { return number_text::write_general(p, v, 10); }},
       {"std::to_chars shortest (write_shortest)", [](char* p, double v) { return number_text::write_shortest(p, v); }},
+      {"output::write_shortest (sink.csv, Dragonbox)", [](char* p, double v) { return output::write_shortest(p, v); }},
 #ifdef TRACKFLOW_BENCH_FMT
       {"fmt \"{:.10g}\" (FMT_COMPILE)", [](char* p, double v) { return fmt::format_to(p, FMT_COMPILE("{:.10g}"), v); }},
       {"fmt shortest \"{}\" (FMT_COMPILE)", [](char* p, double v) { return fmt::format_to(p, FMT_COMPILE("{}"), v); }},
@@ -78,6 +83,13 @@ int main(int argc, char** argv) {
 #endif
   for (const auto& c : contenders)
     std::printf("  %-46s %7.1f ns per number\n", c.name, 1e9 * c.best / static_cast<double>(values.size()));
+  std::size_t output_differs = 0;
+  for (double v : values) {
+    char a[64], b[64];
+    const std::size_t n = static_cast<std::size_t>(number_text::write_shortest(a, v) - a);
+    if (n != static_cast<std::size_t>(output::write_shortest(b, v) - b) || std::memcmp(a, b, n) != 0) ++output_differs;
+  }
+  std::printf("output::write_shortest texts differing from std::to_chars shortest: %zu of %zu\n", output_differs, values.size());
 #ifdef TRACKFLOW_BENCH_FMT
   // Agreement, on these values and on awkward ones (exponents, integers, signed zero).
   std::vector<double> check = values;
@@ -96,5 +108,5 @@ int main(int argc, char** argv) {
   std::printf("texts differing from std::to_chars of %zu values: \"{:.10g}\" %zu, shortest \"{}\" %zu%s%s\n", check.size(),
               precision_differs, shortest_differs, example.empty() ? "" : ", e.g. ", example.c_str());
 #endif
-  return 0;
+  return output_differs == 0 ? 0 : 1;
 }

@@ -1,8 +1,11 @@
-// Purpose: assembles CSV rows in a stack buffer appended to a reused string once a row: numbers through number_text (shortest round-trip or "%.*g"), empty cells for missing values, "nan"/"inf" (counted) for non-finite ones.
+// Purpose: assembles CSV rows in a stack buffer appended to a reused string once a row: numbers shortest round-trip (output::write_shortest, std::to_chars' text) or "%.*g" (number_text), empty cells for missing values, "nan"/"inf" (counted) for non-finite ones.
 #pragma once
+
+#include "output/shortest_double.hpp"
 
 #include <trackflow/number_text.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
@@ -15,7 +18,8 @@ namespace trackflow::csv {
 class RowWriter {
  public:
   // `precision`: significant digits ("%.*g", 1 to 17), or kShortest: the shortest text that reads
-  // back as exactly the same double (std::from_chars, strtod; lossless).
+  // back as exactly the same double (std::from_chars, strtod; lossless), byte for byte
+  // std::to_chars' shortest form.
   static constexpr int kShortest = 0;
 
   RowWriter(std::string& out, int precision) : out_(out), precision_(precision) {}
@@ -26,13 +30,13 @@ class RowWriter {
   // A value that exists. Non-finite ones are written as they are ("nan", "inf", "-inf") -- an
   // empty cell means "no value", which a NaN is not -- and counted, so the sink can fail the run.
   void real(double v) {
-    cell(number_text::kWriteRoom);
+    cell(kNumberRoom);
     if (!std::isfinite(v)) {
       put(std::isnan(v) ? "nan" : v > 0 ? "inf" : "-inf");
       if (non_finite_++ == 0) first_non_finite_ = column_;
       return;
     }
-    at_ = precision_ == kShortest ? number_text::write_shortest(at_, v) : number_text::write_general(at_, v, precision_);
+    at_ = precision_ == kShortest ? output::write_shortest(at_, v) : number_text::write_general(at_, v, precision_);
   }
   void real_if(bool present, double v) {
     if (present)
@@ -68,6 +72,8 @@ class RowWriter {
 
  private:
   static constexpr std::size_t kLongText = 256;
+  // Room a number's writer needs after the separator.
+  static constexpr std::size_t kNumberRoom = std::max(number_text::kWriteRoom, output::kShortestRoom);
 
   // A separator (unless first in the row) with room for `n` characters after it.
   void cell(std::size_t n) {
