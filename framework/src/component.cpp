@@ -36,6 +36,10 @@ const char* to_string(ComponentKind k) {
     case ComponentKind::Filter: return "filter";
     case ComponentKind::Adapter: return "adapter";
     case ComponentKind::Sink: return "sink";
+    case ComponentKind::Tracker: return "tracker";
+    case ComponentKind::Associator: return "associator";
+    case ComponentKind::Initiator: return "initiator";
+    case ComponentKind::Deleter: return "deleter";
   }
   return "?";
 }

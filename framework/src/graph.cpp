@@ -49,6 +49,10 @@ Graph build_graph(PipelineConfig cfg, const PluginRegistry& registry) {
     n.type = registry.find(nc.type);
     if (!n.type) throw ConfigError(unknown_type_message(nc.type, registry), nc.type_loc, nc.id);
     const ComponentDecl& d = n.type->decl;
+    if (d.kind == ComponentKind::Associator || d.kind == ComponentKind::Initiator || d.kind == ComponentKind::Deleter)
+      throw ConfigError(quote_token(nc.type) + " is a tracker's " + to_string(d.kind) + ", not a node: give it inside a tracker, e.g. " +
+                            std::string(to_string(d.kind)) + ": { type: " + nc.type + ", ... } in tracker.multi's params",
+                        nc.type_loc, nc.id);
     // Pipeline-wide settings (on_bad_row, sites, frame_origin) apply to every node that declares the
     // parameter and does not set it itself.
     Value params = nc.params;

@@ -132,8 +132,10 @@ void PluginRegistry::load_file(const std::string& path, bool builtin) {
   }
   LoadedPlugin loaded{path, info->plugin_name ? info->plugin_name : "", {}};
   for (auto& d : reg.decls) {
-    if (!d.create) {
-      problems_.push_back({path, "register", "type '" + d.type + "' has no factory"});
+    const bool part = d.kind == ComponentKind::Associator || d.kind == ComponentKind::Initiator ||
+                      d.kind == ComponentKind::Deleter;
+    if (part ? !d.create_part : !d.create) {
+      problems_.push_back({path, "register", "type '" + d.type + "' has no factory" + (part ? " (create_part)" : "")});
       continue;
     }
     if (const RegisteredType* prev = find(d.type)) {

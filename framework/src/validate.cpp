@@ -96,6 +96,7 @@ NestedComponent parse_component(const ParamSpec& s, const Value& v, const std::s
     }
   NestedComponent out{decl->type, validate_params(decl->params, rest, node, v.loc, types), type->loc, {}};
   out.estimator_factory = decl->create_estimator;
+  out.part_factory = decl->create_part;
   return out;
 }
 

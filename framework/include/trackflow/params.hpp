@@ -103,6 +103,7 @@ struct ParamSpec {
 class Params;
 struct NestedComponent;
 class Estimator;
+class TrackerPart;
 
 struct ParamValue {
   ParamType type = ParamType::Real;
@@ -179,6 +180,9 @@ struct NestedComponent {
   // the host at validation; empty when the type declares none. Its code lives in that type's
   // plugin, which the host keeps loaded while the pipeline that named it exists.
   std::function<std::unique_ptr<Estimator>(const Params&)> estimator_factory;
+  // The nested type's tracker-part factory (ComponentDecl::create_part), likewise; make_part
+  // (tracker.hpp) creates the part.
+  std::function<std::unique_ptr<TrackerPart>(const Params&)> part_factory;
 
   // The nested type's estimator from `params`, for a component composed of estimators (filter.imm's
   // modes). Throws ConfigError at the `type:` value when the type declares no estimator.

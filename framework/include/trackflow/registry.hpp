@@ -12,7 +12,9 @@
 
 namespace trackflow {
 
-enum class ComponentKind { Source, Converter, Filter, Adapter, Sink };
+// Tracker: a node from scans to track sets. Associator, Initiator, Deleter: the parts of a tracker
+// (tracker.hpp), only ever given as its nested `{type: ...}` parameters, never as nodes.
+enum class ComponentKind { Source, Converter, Filter, Adapter, Sink, Tracker, Associator, Initiator, Deleter };
 const char* to_string(ComponentKind k);
 
 // Declaration of one component type, separate from any pipeline that uses it.
@@ -37,6 +39,9 @@ struct ComponentDecl {
   // A filter whose state estimator runs per track (estimator.hpp): the same parameters make the
   // estimator alone, which a tracker (or filter.imm, as a mode) clones for each track it starts.
   std::function<std::unique_ptr<Estimator>(const Params&)> create_estimator;
+  // A tracker part (kind Associator, Initiator or Deleter): made from its parameters by the
+  // tracker that names it (make_part in tracker.hpp); `create` stays empty.
+  std::function<std::unique_ptr<TrackerPart>(const Params&)> create_part;
 };
 
 class Registrar {

@@ -1,0 +1,92 @@
+// Purpose: the parts a multi-target tracker is composed of — Associator, Initiator, Deleter — and what they see of a track (TrackView); each part is a plugin type the tracker's YAML names.
+#pragma once
+
+#include <trackflow/error.hpp>
+#include <trackflow/estimator.hpp>
+#include <trackflow/params.hpp>
+#include <trackflow/scan.hpp>
+#include <trackflow/tracks.hpp>
+
+#include <boost/config.hpp>
+
+#include <cstdint>
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace trackflow {
+
+// What the parts see of one live track at a scan, after its prediction to the scan's time.
+struct TrackView {
+  std::uint64_t id = 0;
+  TrackStatus status = TrackStatus::Tentative;
+  int hits = 0;            // detections used so far (the initiating ones included)
+  int misses = 0;          // consecutive looks without one
+  int looks = 0;           // scans since the track started (the initiating ones included)
+  std::uint64_t history = 0;  // one bit per look, newest in bit 0: 1 = a detection was used
+  const Estimator* estimator = nullptr;
+  // z^, S and log det S for this scan's sensor; nullptr when the track cannot predict the
+  // measurement (S not positive definite): no detection may then be given to it.
+  const PredictedMeasurement* predicted = nullptr;
+};
+
+// The base of every part (ComponentDecl::create_part gives one). Visible, so that a tracker can
+// tell the part another plugin made (make_part's dynamic_cast across shared objects).
+class BOOST_SYMBOL_VISIBLE TrackerPart {
+ public:
+  virtual ~TrackerPart() = default;
+};
+
+// Data association: which detection of the scan each track takes.
+class BOOST_SYMBOL_VISIBLE Associator : public TrackerPart {
+ public:
+  // detection_of_track[i] (sized as tracks) receives the index in scan.detections given to
+  // tracks[i], or -1; a detection goes to at most one track. The tracks come in a fixed order
+  // (by id), so the answer is the same for any thread count.
+  virtual void associate(std::span<const TrackView> tracks, const Scan& scan, std::span<int> detection_of_track) = 0;
+};
+
+// A new track's first detections: `first` from an earlier scan (time first_time), `second` the
+// index of a detection in the current scan; the tracker initiates a fresh estimator with both.
+struct TrackStart {
+  Measurement first;
+  int second = -1;
+};
+
+// Track initiation and confirmation.
+class BOOST_SYMBOL_VISIBLE Initiator : public TrackerPart {
+ public:
+  // Called once per scan with the detections no track took (indices into scan.detections, in
+  // order). Appends the tracks to start to `starts` (reserved by the tracker; may be left empty)
+  // and keeps what it needs of the rest for later scans.
+  virtual void initiate(const Scan& scan, std::span<const int> unassigned, std::vector<TrackStart>& starts) = 0;
+  // Tentative -> confirmed.
+  virtual bool confirmed(const TrackView& track) const = 0;
+  // A tentative track that will not be confirmed any more: deleted.
+  virtual bool failed(const TrackView& track) const = 0;
+  // A new run: forget the detections kept from the previous one.
+  virtual void reset() = 0;
+};
+
+// Deletion of confirmed (and coasting) tracks.
+class BOOST_SYMBOL_VISIBLE Deleter : public TrackerPart {
+ public:
+  virtual bool drop(const TrackView& track) const = 0;
+};
+
+// The part a nested `{type: ...}` parameter names, created by its plugin (the host sets the
+// factory at validation). Throws ConfigError at the `type:` value when that type is not a `Part`.
+template <class Part>
+std::unique_ptr<Part> make_part(const NestedComponent& c, const char* what) {
+  if (!c.part_factory)
+    throw ConfigError(c.type + " is not a tracker part (" + what + ")", c.type_where, c.params.node());
+  std::unique_ptr<TrackerPart> p = c.part_factory(c.params);
+  if (auto* typed = dynamic_cast<Part*>(p.get())) {
+    p.release();
+    return std::unique_ptr<Part>(typed);
+  }
+  throw ConfigError(c.type + " is not " + what, c.type_where, c.params.node());
+}
+
+}  // namespace trackflow

@@ -1,0 +1,452 @@
+// Purpose: tracker.multi — a multi-target tracker composed of parts: per scan it predicts every track, lets the associator give detections to tracks, updates, confirms and deletes (initiator, deleter), starts tracks from what no track took (initiator), and publishes one TrackSet.
+#include <trackflow/component.hpp>
+#include <trackflow/error.hpp>
+#include <trackflow/estimate_state.hpp>
+#include <trackflow/estimator.hpp>
+#include <trackflow/plugin.hpp>
+#include <trackflow/run_result_codec.hpp>
+#include <trackflow/tracker.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace trackflow {
+namespace {
+
+// Per run, summed over the ensemble.
+struct TrackerRunResult final : RunResult {
+  std::uint64_t scans = 0, scans_not_looked = 0, scans_skipped = 0, detections = 0, updates = 0,
+                updates_refused = 0, started = 0, start_failed = 0, confirmed = 0, deleted = 0, deleted_non_finite = 0,
+                track_limit_refused = 0, confirmed_track_scans = 0;
+  template <class Self, class F>
+  static void fields(Self& r, F&& f) {
+    f(r.scans, r.scans_not_looked, r.scans_skipped, r.detections, r.updates, r.updates_refused, r.started,
+      r.start_failed, r.confirmed, r.deleted, r.deleted_non_finite, r.track_limit_refused, r.confirmed_track_scans);
+  }
+};
+
+// One track: its estimator (a clone of the configured one), what it publishes, and its history.
+struct Track final : TrackContext {
+  std::unique_ptr<Estimator> estimator;
+  TrackEstimate published;
+  PredictedMeasurement predicted;
+  bool can_predict = false;
+  int looks = 0;
+  std::uint64_t history = 0;
+  double last_time = 0.0;
+  // Warnings of the estimator go to the tracker, which reports the first of each run.
+  std::vector<std::string>* warnings = nullptr;
+
+  void warn(const std::string& message) override {
+    if (warnings) warnings->push_back(who + ": " + message);
+  }
+  void count(int) override {}
+  void annotate(int, double) override {}
+
+  TrackView view() const {
+    TrackView v;
+    v.id = published.id;
+    v.status = published.status;
+    v.hits = published.hits;
+    v.misses = published.misses;
+    v.looks = looks;
+    v.history = history;
+    v.estimator = estimator.get();
+    v.predicted = can_predict ? &predicted : nullptr;
+    return v;
+  }
+};
+
+bool finite(const Estimate& e) {
+  return std::isfinite(e.state.sum() + e.covariance.sum() + e.enu.sum() + e.enu_covariance.sum());
+}
+
+class MultiTracker final : public Component, public FieldListCodec<TrackerRunResult> {
+ public:
+  MultiTracker(std::string node, std::unique_ptr<Estimator> prototype, std::unique_ptr<Associator> associator,
+               std::unique_ptr<Initiator> initiator, std::unique_ptr<Deleter> deleter, int max_tracks)
+      : node_(std::move(node)),
+        prototype_(std::move(prototype)),
+        associator_(std::move(associator)),
+        initiator_(std::move(initiator)),
+        deleter_(std::move(deleter)),
+        max_tracks_(max_tracks) {}
+
+  void start_run(const RunContext& ctx) override {
+    diag_ = ctx.diagnostics;
+    run_ = TrackerRunResult{};
+    tracks_.clear();
+    next_id_ = 1;
+    has_time_ = false;
+    warnings_.clear();
+    warned_ = false;
+    initiator_->reset();
+  }
+
+  void on_scan(const Scan& s, int) override {
+    if (has_time_ && s.time < last_time_) {
+      ++run_.scans_skipped;
+      if (diag_) diag_->skip(node_, "scan at t=" + std::to_string(s.time) + " s is older than the previous one");
+      return;
+    }
+    has_time_ = true;
+    last_time_ = s.time;
+    ++run_.scans;
+    if (!s.valid) {  // the sensor did not look: no information, nothing missed
+      ++run_.scans_not_looked;
+      publish(s.time);
+      return;
+    }
+    check(s);
+    run_.detections += s.detections.size();
+    predict(s);
+    associate(s);
+    update(s);
+    manage();
+    initiate(s);
+    publish(s.time);
+    report_warnings();
+  }
+
+  std::unique_ptr<RunResult> end_run() override { return std::make_unique<TrackerRunResult>(run_); }
+  void merge(RunResult& result) override {
+    const auto& r = static_cast<const TrackerRunResult&>(result);
+    ++runs_;
+    TrackerRunResult::fields(total_, [&](auto&... t) {
+      TrackerRunResult::fields(r, [&](const auto&... x) { ((t += x), ...); });
+    });
+  }
+  void finish(Summary& s, const FinishContext&) override {
+    const double runs = runs_ ? static_cast<double>(runs_) : 1.0;
+    s.metric("scans", static_cast<double>(total_.scans));
+    s.metric("tracks_started_per_run", static_cast<double>(total_.started) / runs);
+    s.metric("tracks_confirmed_per_run", static_cast<double>(total_.confirmed) / runs);
+    s.metric("tracks_deleted_per_run", static_cast<double>(total_.deleted) / runs);
+    s.metric("confirmed_tracks_per_scan",
+             total_.scans ? static_cast<double>(total_.confirmed_track_scans) / static_cast<double>(total_.scans) : 0.0);
+    s.metric("updates", static_cast<double>(total_.updates));
+    if (total_.updates_refused) s.metric("updates_refused", static_cast<double>(total_.updates_refused));
+    if (total_.start_failed) s.metric("starts_failed", static_cast<double>(total_.start_failed));
+    if (total_.scans_not_looked) s.metric("scans_not_looked", static_cast<double>(total_.scans_not_looked));
+    if (total_.scans_skipped) s.metric("scans_skipped", static_cast<double>(total_.scans_skipped));
+    if (total_.deleted_non_finite) s.metric("deleted_non_finite", static_cast<double>(total_.deleted_non_finite));
+    if (total_.track_limit_refused) {
+      s.metric("starts_refused_at_max_tracks", static_cast<double>(total_.track_limit_refused));
+      s.notes.push_back(std::to_string(total_.track_limit_refused) + " track start(s) refused: max_tracks (" +
+                        std::to_string(max_tracks_) + ") tracks were alive");
+    }
+  }
+
+ private:
+  // A scan the estimator cannot take is a data error (the wiring was checked; the values are the data's).
+  void check(const Scan& s) const {
+    const MeasurementSpec& spec = prototype_->measurement_spec();
+    if (s.sensor.frame != spec.frame)
+      throw DataError("tracker.multi (node '" + node_ + "'): its estimator takes " + to_string(spec.frame) +
+                      " detections, but the scan at t=" + std::to_string(s.time) + " s is " + to_string(s.sensor.frame));
+    if (!s.sensor.sensor_level && !spec.tilted_sensors)
+      throw DataError("tracker.multi (node '" + node_ + "'): the scan at t=" + std::to_string(s.time) +
+                      " s comes from a tilted sensor, which its estimator does not turn into");
+    for (const Detection& d : s.detections) {
+      const int n = static_cast<int>(d.value.size());
+      if (n != (d.has_range_rate ? 4 : 3) || d.covariance.rows() != n || d.covariance.cols() != n ||
+          !d.value.allFinite() || !d.covariance.allFinite())
+        throw DataError("tracker.multi (node '" + node_ + "'): a detection of the scan at t=" + std::to_string(s.time) +
+                        " s has " + std::to_string(n) + " values and a " + std::to_string(d.covariance.rows()) + "x" +
+                        std::to_string(d.covariance.cols()) + " covariance, or non-finite ones");
+    }
+  }
+
+  int dimension(const Detection& d) const {
+    switch (prototype_->measurement_spec().range_rate) {
+      case RangeRateUse::Use: return 4;
+      case RangeRateUse::Auto: return d.has_range_rate ? 4 : 3;
+      case RangeRateUse::Ignore: break;
+    }
+    return 3;
+  }
+
+  // The estimator's R from detection d (its leading dim x dim block).
+  void set_R(Estimator& e, const Detection& d, int dim) const {
+    MeasCov& R = e.measurement_noise();
+    R = d.covariance.topLeftCorner(dim, dim);
+  }
+
+  void to_measurement(const Scan& s, const Detection& d, Measurement& m) const {
+    static_cast<SensorFrame&>(m) = s.sensor;
+    static_cast<Detection&>(m) = d;
+    m.time = s.time;
+    m.valid = true;
+  }
+
+  // Every track to the scan's time, and its predicted measurement with the scan's R (that of its
+  // first detection: a sensor reports one R per look; an empty scan needs none).
+  void predict(const Scan& s) {
+    views_.clear();
+    for (Track& t : tracks_) {
+      rebind(t);  // the slot may have moved since the last scan
+      const double T = s.time - t.last_time;
+      t.time = s.time;
+      if (T > 0.0) t.estimator->predict(T);
+      t.last_time = s.time;
+      t.can_predict = false;
+      if (!s.detections.empty()) {
+        const Detection& d = s.detections.front();
+        set_R(*t.estimator, d, dimension(d));
+        t.can_predict = t.estimator->predict_measurement(s.sensor, t.estimator->measurement_noise(), t.predicted);
+      }
+      views_.push_back(t.view());
+    }
+  }
+
+  void associate(const Scan& s) {
+    assigned_.assign(tracks_.size(), -1);
+    taken_.assign(s.detections.size(), 0);
+    if (tracks_.empty() || s.detections.empty()) return;
+    associator_->associate(views_, s, assigned_);
+    for (size_t i = 0; i < assigned_.size(); ++i) {
+      const int j = assigned_[i];
+      if (j < 0) continue;
+      if (j >= static_cast<int>(s.detections.size()) || taken_[static_cast<size_t>(j)] || !views_[i].predicted)
+        throw std::logic_error("tracker.multi (node '" + node_ + "'): the associator gave detection " + std::to_string(j) +
+                            " of " + std::to_string(s.detections.size()) +
+                            " to a track that cannot take it, or to two tracks (a bug in that plugin)");
+      taken_[static_cast<size_t>(j)] = 1;
+    }
+  }
+
+  void update(const Scan& s) {
+    for (size_t i = 0; i < tracks_.size(); ++i) {
+      Track& t = tracks_[i];
+      ++t.looks;
+      bool used = false;
+      if (assigned_[i] >= 0) {
+        const Detection& d = s.detections[static_cast<size_t>(assigned_[i])];
+        const int dim = dimension(d);
+        to_measurement(s, d, m_);
+        set_R(*t.estimator, d, dim);
+        t.published.estimate.updated = false;
+        used = t.estimator->update(m_, dim);
+        ++(used ? run_.updates : run_.updates_refused);
+      }
+      t.history = (t.history << 1) | (used ? 1u : 0u);
+      if (used) {
+        ++t.published.hits;
+        t.published.misses = 0;
+      } else {
+        ++t.published.misses;
+      }
+      views_[i] = t.view();
+    }
+  }
+
+  // Tentative tracks confirmed or failed (the initiator), confirmed ones coasting or dropped (the deleter).
+  void manage() {
+    for (size_t i = 0; i < tracks_.size(); ++i) {
+      TrackEstimate& p = tracks_[i].published;
+      const TrackView& v = views_[i];
+      if (p.status == TrackStatus::Tentative) {
+        if (initiator_->confirmed(v)) {
+          p.status = TrackStatus::Confirmed;
+          ++run_.confirmed;
+        } else if (initiator_->failed(v)) {
+          p.status = TrackStatus::Deleted;
+        }
+      } else if (deleter_->drop(v)) {
+        p.status = TrackStatus::Deleted;
+      } else {
+        p.status = p.misses > 0 ? TrackStatus::Coasting : TrackStatus::Confirmed;
+      }
+      if (p.status == TrackStatus::Deleted) ++run_.deleted;
+    }
+  }
+
+  void initiate(const Scan& s) {
+    unassigned_.clear();
+    for (size_t j = 0; j < s.detections.size(); ++j)
+      if (!taken_[j]) unassigned_.push_back(static_cast<int>(j));
+    starts_.clear();
+    initiator_->initiate(s, unassigned_, starts_);
+    for (const TrackStart& st : starts_) {
+      if (st.second < 0 || st.second >= static_cast<int>(s.detections.size()))
+        throw std::logic_error("tracker.multi (node '" + node_ + "'): the initiator started a track from detection " +
+                            std::to_string(st.second) + " of " + std::to_string(s.detections.size()) +
+                            " (a bug in that plugin)");
+      if (alive() >= max_tracks_) {
+        ++run_.track_limit_refused;
+        continue;
+      }
+      Track& t = new_track();
+      t.estimator->reset();
+      t.time = st.first.time;
+      const int dim1 = dimension(st.first);
+      set_R(*t.estimator, st.first, dim1);
+      bool formed = t.estimator->initiate(st.first, dim1);
+      if (!formed) {
+        const Detection& d = s.detections[static_cast<size_t>(st.second)];
+        to_measurement(s, d, m_);
+        t.time = s.time;
+        const int dim2 = dimension(d);
+        set_R(*t.estimator, d, dim2);
+        formed = t.estimator->initiate(m_, dim2);
+      }
+      if (!formed) {
+        ++run_.start_failed;
+        tracks_.pop_back();
+        continue;
+      }
+      ++run_.started;
+      t.published.id = next_id_++;
+      t.published.status = TrackStatus::Tentative;
+      t.published.hits = 2;
+      t.published.misses = 0;
+      t.published.score = std::numeric_limits<double>::quiet_NaN();
+      t.looks = 2;
+      t.history = 0b11;
+      t.last_time = s.time;
+      t.published.estimate.target = st.first.origin == s.detections[static_cast<size_t>(st.second)].origin
+                                        ? st.first.origin
+                                        : kOriginUnknown;
+    }
+  }
+
+  int alive() const {
+    int n = 0;
+    for (const Track& t : tracks_) n += t.published.status != TrackStatus::Deleted;
+    return n;
+  }
+
+  // A slot for a new track at the end (ids grow, so the list stays in id order); a slot is reused
+  // with its estimator's storage once the population is steady.
+  Track& new_track() {
+    if (spare_.empty()) {
+      tracks_.emplace_back();
+      tracks_.back().estimator = prototype_->clone();
+    } else {
+      tracks_.push_back(std::move(spare_.back()));
+      spare_.pop_back();
+    }
+    Track& t = tracks_.back();
+    t.who = "tracker.multi (node '" + node_ + "') track";
+    t.warnings = &warnings_;
+    rebind(t);
+    return t;
+  }
+
+  // The estimator reports to its track's context, which lives in a slot that moves when the list changes.
+  void rebind(Track& t) {
+    t.estimate = &t.published.estimate;
+    t.estimator->bind(t);
+  }
+
+  // Each track's estimate at time t; the deleted ones published once, then their slots freed.
+  void publish(double t) {
+    set_.clear();
+    std::uint64_t confirmed = 0;
+    for (Track& tr : tracks_) {
+      Estimate& e = tr.published.estimate;
+      tr.estimator->fill(e);
+      e.time = t;
+      e.initialised = true;
+      if (tr.published.status != TrackStatus::Deleted && !finite(e)) {
+        tr.published.status = TrackStatus::Deleted;
+        ++run_.deleted;
+        ++run_.deleted_non_finite;
+        warnings_.push_back("track " + std::to_string(tr.published.id) + ": the state came out non-finite at t=" +
+                            std::to_string(t) + " s; deleted");
+      }
+      if (tr.published.status == TrackStatus::Deleted && !finite(e)) set_uninitialised(e, t);
+      confirmed += tr.published.status == TrackStatus::Confirmed || tr.published.status == TrackStatus::Coasting;
+      set_.push_back(tr.published);
+    }
+    run_.confirmed_track_scans += confirmed;
+    out.emit(TrackSet{t, set_});
+    for (size_t i = tracks_.size(); i-- > 0;) {
+      if (tracks_[i].published.status != TrackStatus::Deleted) continue;
+      spare_.push_back(std::move(tracks_[i]));
+      tracks_.erase(tracks_.begin() + static_cast<std::ptrdiff_t>(i));
+    }
+  }
+
+  void report_warnings() {
+    if (!warnings_.empty() && !warned_ && diag_)
+      diag_->warn(node_, warnings_.front() + (warnings_.size() > 1 ? " (further warnings of this run not shown)" : ""));
+    warned_ = warned_ || !warnings_.empty();
+    warnings_.clear();
+  }
+
+  std::string node_;
+  std::unique_ptr<Estimator> prototype_;
+  std::unique_ptr<Associator> associator_;
+  std::unique_ptr<Initiator> initiator_;
+  std::unique_ptr<Deleter> deleter_;
+  int max_tracks_ = 0;
+  Diagnostics* diag_ = nullptr;
+  TrackerRunResult run_, total_;
+  std::uint64_t runs_ = 0;
+  std::vector<Track> tracks_, spare_;
+  std::vector<TrackView> views_;
+  std::vector<int> assigned_, unassigned_;
+  std::vector<char> taken_;
+  std::vector<TrackStart> starts_;
+  std::vector<TrackEstimate> set_;
+  std::vector<std::string> warnings_;
+  bool warned_ = false;
+  Measurement m_;
+  std::uint64_t next_id_ = 1;
+  double last_time_ = 0.0;
+  bool has_time_ = false;
+};
+
+std::unique_ptr<Component> create(const Params& p) {
+  std::unique_ptr<Estimator> estimator = p.component("estimator").create_estimator();
+  auto associator = make_part<Associator>(p.component("associator"), "an associator");
+  auto initiator = make_part<Initiator>(p.component("initiator"), "an initiator");
+  auto deleter = make_part<Deleter>(p.component("deleter"), "a deleter");
+  return std::make_unique<MultiTracker>(p.node(), std::move(estimator), std::move(associator), std::move(initiator),
+                                        std::move(deleter), static_cast<int>(p.integer("max_tracks")));
+}
+
+void register_components(Registrar& r) {
+  ComponentDecl d;
+  d.type = "tracker.multi";
+  d.kind = ComponentKind::Tracker;
+  d.summary = "Multi-target tracker composed of an estimator per track, an associator, an initiator and a deleter; "
+              "one TrackSet per scan";
+  d.doc =
+      "Per scan (Stone Soup's MultiTargetTracker): every track is predicted to the scan's time and gives its "
+      "predicted measurement (z^, S, log det S; the scan's R is its first detection's); the associator gives "
+      "detections to tracks; each track updates with its detection or misses; the initiator confirms tentative "
+      "tracks or fails them, the deleter drops confirmed ones; the initiator starts tracks from the detections no "
+      "track took; the set of all tracks is published (a deleted track once, with status deleted). Track ids are "
+      "unique in a run and never reused. A scan with valid: false (the sensor did not look) changes nothing. A track "
+      "whose state comes out non-finite is deleted and counted. The estimator is any filter type with a per-track "
+      "estimator (filter.kalman, filter.ekf, filter.ukf, filter.imm, ...), with that filter's parameters. See "
+      "docs/multi-target.md.";
+  d.accepts = mask(ItemKind::Scan);
+  d.produces = mask(ItemKind::Tracks);
+  d.params = {
+      ParamSpec::component("estimator", {ComponentKind::Filter},
+                           "each track's estimator: a filter type and its parameters, e.g. { type: filter.kalman, q: 1 m2/s3 }")
+          .req(),
+      ParamSpec::component("associator", {ComponentKind::Associator}, "data association, e.g. { type: assoc.gnn }").req(),
+      ParamSpec::component("initiator", {ComponentKind::Initiator}, "track initiation and confirmation, e.g. { type: init.m_of_n }")
+          .req(),
+      ParamSpec::component("deleter", {ComponentKind::Deleter}, "deletion of confirmed tracks, e.g. { type: delete.misses }").req(),
+      ParamSpec::integer("max_tracks", "at most this many tracks alive; further starts are refused and counted")
+          .def("10000")
+          .at_least(1),
+  };
+  d.create = create;
+  r.add(std::move(d));
+}
+
+}  // namespace
+}  // namespace trackflow
+
+TRACKFLOW_PLUGIN("tracker.multi", trackflow::register_components)

@@ -1,0 +1,174 @@
+// Purpose: tests of tracker.multi with filter.kalman, assoc.gnn / assoc.nearest, init.m_of_n and delete.misses, scans fed by hand: two targets in clutter become two confirmed tracks that keep their targets; ids are never reused; a track is deleted after its misses; a scan that was not a look changes nothing; the run result survives the codec.
+#include <catch2/catch.hpp>
+
+#include "plugin_fixture.hpp"
+
+#include <trackflow/rng.hpp>
+#include <trackflow/run_result_codec.hpp>
+#include <trackflow/tracks.hpp>
+
+#include <map>
+#include <memory>
+#include <set>
+#include <string>
+#include <vector>
+
+using namespace trackflow;
+
+namespace {
+
+struct SetCollector : Component {
+  struct Seen {
+    double time;
+    std::vector<TrackEstimate> tracks;
+  };
+  std::vector<Seen> sets;
+  Link link{this, 0, 0xFF};
+  void on_tracks(const TrackSet& s, int) override { sets.push_back({s.time, {s.tracks.begin(), s.tracks.end()}}); }
+  void attach_to(Component& c) { c.out.connect(&link, 1); }
+};
+
+std::string tracker_yaml(const std::string& associator, int max_misses = 3) {
+  return "{ estimator: { type: filter.kalman, q: 0.1 m2/s3 }, associator: { type: " + associator +
+         " }, initiator: { type: init.m_of_n, m: 3, n: 4, max_speed: 50 m/s }, deleter: { type: delete.misses, "
+         "max_misses: " +
+         std::to_string(max_misses) + " } }";
+}
+
+// Two targets 200 m apart in x at 10 m/s, crossing in y: target 1 (0, -100) -> +y, target 2 (200, 100) -> -y...
+// measured every second with sigma 2 m, P_D 1, and `clutter` false detections uniform in a 1 km cube.
+struct Scenario {
+  Rng rng{5};
+  std::vector<Detection> detections;
+  Scan scan_at(double t, int clutter, bool see_second = true) {
+    detections.clear();
+    const Vec3 p1(0.0, -100.0 + 10.0 * t, 0.0), p2(200.0, 100.0 - 10.0 * t, 0.0);
+    add(p1, 1);
+    if (see_second) add(p2, 2);
+    for (int k = 0; k < clutter; ++k) {
+      Detection d;
+      d.value = Vec3(1000 * rng.uniform() - 500, 1000 * rng.uniform() - 500, 1000 * rng.uniform() - 500);
+      d.covariance = MeasCov::Identity(3, 3) * 4.0;
+      d.origin = kOriginClutter;
+      detections.push_back(d);
+    }
+    Scan s;
+    s.time = t;
+    s.sensor.frame = Frame::Cartesian;
+    s.detections = detections;
+    s.detection_probability = 0.99;
+    s.clutter_density = (clutter > 0 ? clutter : 1) / 1e9;
+    return s;
+  }
+  void add(const Vec3& p, std::uint32_t origin) {
+    Detection d;
+    d.value = p + 2.0 * Vec3(rng.normal(), rng.normal(), rng.normal());
+    d.covariance = MeasCov::Identity(3, 3) * 4.0;
+    d.origin = origin;
+    detections.push_back(d);
+  }
+};
+
+std::vector<const TrackEstimate*> confirmed(const SetCollector::Seen& s) {
+  std::vector<const TrackEstimate*> out;
+  for (const TrackEstimate& t : s.tracks)
+    if (t.status == TrackStatus::Confirmed || t.status == TrackStatus::Coasting) out.push_back(&t);
+  return out;
+}
+
+}  // namespace
+
+TEST_CASE("two targets in clutter: two tracks that keep them") {
+  for (const char* assoc : {"assoc.gnn", "assoc.nearest"}) {
+    INFO(assoc);
+    auto n = test::make("tracker.multi", tracker_yaml(assoc));
+    SetCollector out;
+    out.attach_to(*n);
+    test::start_run(*n);
+    Scenario sc;
+    for (int k = 0; k < 20; ++k) n->on_scan(sc.scan_at(k, 5), 0);
+    REQUIRE(out.sets.size() == 20);
+    // From the 4th scan on (two to start, two more to confirm 3 of 4) both targets are confirmed.
+    std::map<std::uint64_t, std::uint32_t> target_of;
+    for (size_t k = 4; k < out.sets.size(); ++k) {
+      const auto c = confirmed(out.sets[k]);
+      REQUIRE(c.size() == 2);
+      for (const TrackEstimate* t : c) {
+        const double time = out.sets[k].time;
+        const Vec3 p1(0.0, -100.0 + 10.0 * time, 0.0), p2(200.0, 100.0 - 10.0 * time, 0.0);
+        const Vec3 at = t->estimate.enu.head<3>();
+        const std::uint32_t nearest = (at - p1).norm() < (at - p2).norm() ? 1 : 2;
+        CHECK((at - (nearest == 1 ? p1 : p2)).norm() < 10.0);
+        // A track follows one target all along (no swap, no break).
+        if (!target_of.count(t->id)) target_of[t->id] = nearest;
+        CHECK(target_of[t->id] == nearest);
+        CHECK(t->estimate.target == nearest);  // the origin of its initiating detections
+      }
+    }
+    CHECK(target_of.size() == 2);
+  }
+}
+
+TEST_CASE("misses delete, ids never reused, non-looks ignored") {
+  auto n = test::make("tracker.multi", tracker_yaml("assoc.gnn", 2));
+  SetCollector out;
+  out.attach_to(*n);
+  test::start_run(*n);
+  Scenario sc;
+  for (int k = 0; k < 8; ++k) n->on_scan(sc.scan_at(k, 0), 0);
+  REQUIRE(confirmed(out.sets.back()).size() == 2);
+  std::set<std::uint64_t> ids;
+  for (const TrackEstimate* t : confirmed(out.sets.back())) ids.insert(t->id);
+  // A scan with valid: false: the same tracks, no miss counted.
+  Scan off = sc.scan_at(8, 0);
+  off.valid = false;
+  n->on_scan(off, 0);
+  for (const TrackEstimate& t : out.sets.back().tracks) CHECK(t.misses == 0);
+  // The second target unseen for two looks: coasting, then deleted (published once as deleted).
+  n->on_scan(sc.scan_at(9, 0, false), 0);
+  int coasting = 0;
+  for (const TrackEstimate& t : out.sets.back().tracks) coasting += t.status == TrackStatus::Coasting;
+  CHECK(coasting == 1);
+  n->on_scan(sc.scan_at(10, 0, false), 0);
+  int deleted = 0;
+  for (const TrackEstimate& t : out.sets.back().tracks) deleted += t.status == TrackStatus::Deleted;
+  CHECK(deleted == 1);
+  n->on_scan(sc.scan_at(11, 0, false), 0);
+  CHECK(out.sets.back().tracks.size() == 1);
+  // It comes back: a new track with a new id.
+  for (int k = 12; k < 18; ++k) n->on_scan(sc.scan_at(k, 0), 0);
+  const auto c = confirmed(out.sets.back());
+  REQUIRE(c.size() == 2);
+  int fresh = 0;
+  for (const TrackEstimate* t : c) fresh += !ids.count(t->id);
+  CHECK(fresh == 1);
+}
+
+TEST_CASE("run result codec, wrong part refused") {
+  auto n = test::make("tracker.multi", tracker_yaml("assoc.gnn"));
+  SetCollector out;
+  out.attach_to(*n);
+  test::start_run(*n);
+  Scenario sc;
+  for (int k = 0; k < 6; ++k) n->on_scan(sc.scan_at(k, 3), 0);
+  std::unique_ptr<RunResult> r = n->end_run();
+  auto* codec = dynamic_cast<RunResultCodec*>(n.get());
+  REQUIRE(codec);
+  std::string bytes;
+  ByteWriter w(bytes);
+  codec->save_run_result(*r, w);
+  ByteReader rd(bytes.data(), bytes.size());
+  std::unique_ptr<RunResult> back = codec->load_run_result(rd);
+  CHECK(rd.done());
+  n->merge(*back);
+  Summary s;
+  n->finish(s, FinishContext{});
+  REQUIRE(s.find("tracks_confirmed_per_run"));
+  CHECK(s.find("tracks_confirmed_per_run")->value == 2.0);
+  CHECK(s.find("scans")->value == 6.0);
+  // A wrong part type in a slot is refused at creation, naming what was wanted.
+  CHECK_THROWS_WITH(test::make("tracker.multi",
+                               "{ estimator: { type: filter.kalman }, associator: { type: init.m_of_n, max_speed: 1 m/s }, "
+                               "initiator: { type: init.m_of_n, max_speed: 1 m/s }, deleter: { type: delete.misses } }"),
+                    Catch::Contains("init.m_of_n"));
+}
