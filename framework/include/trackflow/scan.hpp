@@ -39,4 +39,13 @@ struct Scan {
   double detection_probability = std::numeric_limits<double>::quiet_NaN();
 };
 
+// One detection of a scan as the single-detection Measurement an estimator takes (no allocation:
+// the value and covariance are fixed-capacity).
+inline void to_measurement(const Scan& s, const Detection& d, Measurement& m) {
+  static_cast<SensorFrame&>(m) = s.sensor;
+  static_cast<Detection&>(m) = d;
+  m.time = s.time;
+  m.valid = true;
+}
+
 }  // namespace trackflow

@@ -104,10 +104,7 @@ void register_components(Registrar& r) {
       "P_D and the clutter density lambda are the scan's when it states them, else the parameters. A detection no "
       "track takes goes to the initiator. See docs/multi-target.md.";
   d.params = {
-      ParamSpec::real("gate_probability", Dimension{}, "P_G: probability that a target's detection falls in its gate")
-          .def("0.99")
-          .positive()
-          .at_most(0.999999),
+      association::gate_probability_param(),
       ParamSpec::real("detection_probability", Dimension{}, "P_D when the scan does not state it").def("0.9").positive().at_most(1),
       ParamSpec::real("clutter_density", Dimension{-3, 0, 0, 0},
                       "false detections per m3 of Cartesian measurement space when the scan does not state it")

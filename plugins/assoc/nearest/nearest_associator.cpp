@@ -66,10 +66,7 @@ void register_components(Registrar& r) {
       "detection); pairs are taken in that order while neither side is taken. Locally, not jointly, best: at "
       "crossings it can give a track its neighbour's detection where assoc.gnn would not. See docs/multi-target.md.";
   d.params = {
-      ParamSpec::real("gate_probability", Dimension{}, "P_G: probability that a target's detection falls in its gate")
-          .def("0.99")
-          .positive()
-          .at_most(0.999999),
+      association::gate_probability_param(),
   };
   d.create_part = create_part;
   r.add(std::move(d));

@@ -56,9 +56,7 @@ class MofNInitiator final : public Initiator {
     current_.clear();
     for (int j : unassigned) {
       Measurement m;
-      static_cast<SensorFrame&>(m) = scan.sensor;
-      static_cast<Detection&>(m) = scan.detections[static_cast<size_t>(j)];
-      m.time = scan.time;
+      to_measurement(scan, scan.detections[static_cast<size_t>(j)], m);
       current_.push_back({m, locate(m), j});
     }
     const int rows = static_cast<int>(pending_.size()), m = static_cast<int>(current_.size()), cols = m + rows;

@@ -1,9 +1,10 @@
-// Purpose: a detection against a track's predicted measurement — the residual (azimuth wrapped), its NIS through the Cholesky factor of S, the chi-square gate and the Gaussian log-likelihood — for every associator.
+// Purpose: a detection against a track's predicted measurement — the residual (azimuth wrapped), its NIS through the Cholesky factor of S, the chi-square gate (and its gate_probability parameter) and the Gaussian log-likelihood — for every associator.
 #pragma once
 
 #include <trackflow/estimator.hpp>
 #include <trackflow/geometry.hpp>
 #include <trackflow/items.hpp>
+#include <trackflow/params.hpp>
 
 #include <Eigen/Cholesky>
 
@@ -49,5 +50,13 @@ class PredictedGate {
   Eigen::LLT<MeasCov> llt_;
   double log_det_ = 0.0;
 };
+
+// The gate probability every associator declares the same way.
+inline ParamSpec gate_probability_param() {
+  return ParamSpec::real("gate_probability", Dimension{}, "P_G: probability that a target's detection falls in its gate")
+      .def("0.99")
+      .positive()
+      .at_most(0.999999);
+}
 
 }  // namespace trackflow::association

@@ -177,13 +177,6 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
     R = d.covariance.topLeftCorner(dim, dim);
   }
 
-  void to_measurement(const Scan& s, const Detection& d, Measurement& m) const {
-    static_cast<SensorFrame&>(m) = s.sensor;
-    static_cast<Detection&>(m) = d;
-    m.time = s.time;
-    m.valid = true;
-  }
-
   // Every track to the scan's time, and its predicted measurement with the scan's R (that of its
   // first detection: a sensor reports one R per look; an empty scan needs none).
   void predict(const Scan& s) {
