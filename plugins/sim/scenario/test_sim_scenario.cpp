@@ -1,0 +1,3 @@
+// Purpose: tests of sim.scenario.
+#include <catch2/catch.hpp>
+TEST_CASE("placeholder") {}
