@@ -135,7 +135,8 @@ Settings read_settings(const Params& p) {
   s.steps = static_cast<long long>(std::floor(span + kTimeTolerance / s.period)) + 1;
   s.planar = p.boolean("planar");
 
-  for (const Params& r : p.records("targets")) {
+  static const std::vector<Params> kNone;
+  for (const Params& r : p.has("targets") ? p.records("targets") : kNone) {
     ScriptedTarget t;
     t.position = r.vec3("initial_position");
     t.velocity = r.vec3("initial_velocity");
