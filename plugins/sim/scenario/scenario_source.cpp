@@ -434,7 +434,7 @@ void register_components(Registrar& r) {
       "velocity 0, no z noise); detections stay 3-D, z measured with σ_z, and region_lo/hi may then have 2 values, "
       "the z range being ±3 σ_z. All draws come from this node's run seed, in a fixed order (survival tests, motion "
       "noise per target and axis, random births, then per target a detection test and its noise, clutter count and "
-      "positions), so results are identical for any --threads. See docs/scenarios.md.";
+      "positions), so results are identical for any --threads.";
   d.params = {
       ParamSpec::real("period", dim::time, "time between steps (default 1 s; or rate)").def("1 s").positive(),
       ParamSpec::real("rate", dim::frequency, "instead of period: steps per second").positive(),
