@@ -128,7 +128,7 @@ TEST_CASE("truths of another time are not used") {
   CHECK(metric(sum, "steps_without_truth") == 1.0);
 }
 
-TEST_CASE("planar scoring ignores z; non-finite tracks are skipped") {
+TEST_CASE("planar scoring ignores z and skips non-finite tracks") {
   auto s = make("{ cutoff: 10 m, dimensions: 2 }");
   Vec3 bad(std::nan(""), 0, 0);
   const Summary sum = one_run(*s, {Vec3(0, 0, 0)}, {track(1, Vec3(3, 4, 50)), track(2, bad)});
