@@ -1,0 +1,207 @@
+// Purpose: tests of sink.gospa fed hand-made truths and track sets: hand-worked GOSPA values, status filter, truths of another time, runs merged, the run result's codec, parameter refusals.
+#include <trackflow/error.hpp>
+#include <trackflow/run_result_codec.hpp>
+#include <trackflow/tracks.hpp>
+
+#include <catch2/catch.hpp>
+
+#include <cmath>
+#include <cstring>
+#include <string>
+#include <vector>
+
+#include "plugin_fixture.hpp"
+
+using namespace trackflow;
+
+namespace {
+
+TrackEstimate track(std::uint64_t id, Vec3 p, TrackStatus st = TrackStatus::Confirmed) {
+  TrackEstimate t;
+  t.id = id;
+  t.status = st;
+  t.estimate.initialised = true;
+  t.estimate.enu.setZero();
+  t.estimate.enu.head<3>() = p;
+  return t;
+}
+
+Truth truth(double time, std::uint32_t id, Vec3 p) {
+  Truth t;
+  t.time = time;
+  t.target = id;
+  t.position = p;
+  return t;
+}
+
+std::vector<InputInfo> inputs() {
+  return {{"tracker", "tracker.multi", mask(ItemKind::Tracks), {}}, {"scenario", "sim.scenario", mask(ItemKind::Truth), {}}};
+}
+
+std::shared_ptr<Component> make(const std::string& yaml) {
+  auto s = test::make("sink.gospa", yaml);
+  s->set_inputs(inputs());
+  return s;
+}
+
+// One step at t = 1 s: the truths, then the set.
+void step(Component& s, double time, const std::vector<Vec3>& truths, const std::vector<TrackEstimate>& tracks) {
+  for (std::size_t i = 0; i < truths.size(); ++i) s.on_truth(truth(time, static_cast<std::uint32_t>(i), truths[i]), 1);
+  s.on_tracks(TrackSet{time, tracks}, 0);
+}
+
+double metric(const Summary& s, const std::string& name) {
+  const Metric* m = s.find(name);
+  return m ? m->value : -1.0;
+}
+
+Summary one_run(Component& s, const std::vector<Vec3>& truths, const std::vector<TrackEstimate>& tracks) {
+  test::start_run(s);
+  step(s, 1.0, truths, tracks);
+  auto r = s.end_run();
+  s.merge(*r);
+  Summary sum;
+  s.finish(sum, {});
+  return sum;
+}
+
+}  // namespace
+
+TEST_CASE("one truth and one track closer than c: GOSPA is d") {
+  auto s = make("{ cutoff: 10 m }");
+  const Summary sum = one_run(*s, {Vec3(0, 0, 0)}, {track(1, Vec3(3, 4, 0))});
+  CHECK(metric(sum, "gospa") == Approx(5.0));
+  CHECK(metric(sum, "gospa_localisation") == Approx(25.0));
+  CHECK(metric(sum, "gospa_missed") == 0.0);
+  CHECK(metric(sum, "gospa_false") == 0.0);
+  CHECK(metric(sum, "ospa") == Approx(5.0));
+  CHECK(metric(sum, "missed_targets") == 0.0);
+}
+
+TEST_CASE("a missed target costs (c^p / 2)^(1/p)") {
+  auto s = make("{ cutoff: 10 m, order: 3 }");
+  const Summary sum = one_run(*s, {Vec3(1, 2, 3)}, {});
+  CHECK(metric(sum, "gospa") == Approx(std::cbrt(500.0)));
+  CHECK(metric(sum, "gospa_missed") == Approx(500.0));
+  CHECK(metric(sum, "missed_targets") == 1.0);
+  CHECK(metric(sum, "false_tracks") == 0.0);
+  CHECK(metric(sum, "ospa") == Approx(10.0));
+}
+
+TEST_CASE("a far track is one missed and one false target") {
+  auto s = make("{ cutoff: 10 m }");
+  const Summary sum = one_run(*s, {Vec3(0, 0, 0)}, {track(1, Vec3(100, 0, 0))});
+  CHECK(metric(sum, "gospa") == Approx(10.0));
+  CHECK(metric(sum, "gospa_missed") == Approx(50.0));
+  CHECK(metric(sum, "gospa_false") == Approx(50.0));
+  CHECK(metric(sum, "false_tracks") == 1.0);
+  CHECK(metric(sum, "missed_targets") == 1.0);
+}
+
+TEST_CASE("tentative and deleted tracks are not scored by default") {
+  auto s = make("{ cutoff: 10 m }");
+  const Summary sum = one_run(*s, {Vec3(0, 0, 0)},
+                              {track(1, Vec3(3, 4, 0)), track(2, Vec3(0, 1, 0), TrackStatus::Tentative),
+                               track(3, Vec3(0, 0, 0), TrackStatus::Deleted)});
+  CHECK(metric(sum, "gospa") == Approx(5.0));
+  CHECK(metric(sum, "tracks") == 1.0);
+  auto t = make("{ cutoff: 10 m, statuses: 'tentative, confirmed' }");
+  const Summary sum2 = one_run(*t, {Vec3(0, 0, 0)},
+                               {track(1, Vec3(3, 4, 0)), track(2, Vec3(0, 1, 0), TrackStatus::Tentative)});
+  // The tentative track at 1 m takes the truth; the other is false: (1 + 50)^(1/2).
+  CHECK(metric(sum2, "gospa") == Approx(std::sqrt(51.0)));
+  CHECK(metric(sum2, "false_tracks") == 1.0);
+}
+
+TEST_CASE("truths of another time are not used") {
+  auto s = make("{ cutoff: 10 m }");
+  test::start_run(*s);
+  s->on_truth(truth(0.5, 0, Vec3(0, 0, 0)), 1);  // no set at 0.5 s
+  const std::vector<TrackEstimate> tracks{track(1, Vec3(3, 4, 0))};
+  s->on_tracks(TrackSet{1.0, tracks}, 0);  // scored against no truth: one false track
+  auto r = s->end_run();
+  s->merge(*r);
+  Summary sum;
+  s->finish(sum, {});
+  CHECK(metric(sum, "gospa") == Approx(std::sqrt(50.0)));
+  CHECK(metric(sum, "unscored_truth_steps") == 1.0);
+  CHECK(metric(sum, "steps_without_truth") == 1.0);
+}
+
+TEST_CASE("planar scoring ignores z and skips non-finite tracks") {
+  auto s = make("{ cutoff: 10 m, dimensions: 2 }");
+  Vec3 bad(std::nan(""), 0, 0);
+  const Summary sum = one_run(*s, {Vec3(0, 0, 0)}, {track(1, Vec3(3, 4, 50)), track(2, bad)});
+  CHECK(metric(sum, "gospa") == Approx(5.0));
+  CHECK(metric(sum, "non_finite_tracks") == 1.0);
+}
+
+TEST_CASE("merged runs give the mean of the runs, and a series") {
+  auto s = make("{ cutoff: 10 m }");
+  for (int run = 0; run < 2; ++run) {
+    test::start_run(*s, run);
+    step(*s, 1.0, {Vec3(0, 0, 0)}, {track(1, Vec3(run ? 6 : 3, run ? 8 : 4, 0))});  // d = 5, 10 (not < c: 10)
+    step(*s, 2.0, {Vec3(0, 0, 0)}, {track(1, Vec3(1, 0, 0))});                      // d = 1
+    auto r = s->end_run();
+    s->merge(*r);
+  }
+  Summary sum;
+  s->finish(sum, {});
+  CHECK(metric(sum, "gospa") == Approx((3.0 + 5.5) / 2.0));
+  CHECK(metric(sum, "runs_scored") == 2.0);
+  CHECK(metric(sum, "gospa_ci95_lo") < metric(sum, "gospa"));
+  REQUIRE(sum.series.size() == 1);
+  const Series& ser = sum.series[0];
+  REQUIRE(ser.rows() == 2);
+  CHECK(ser.at(0, ser.column("gospa")) == Approx(7.5));
+  CHECK(ser.at(0, ser.column("gospa_missed")) == Approx(25.0));
+  CHECK(ser.at(1, ser.column("gospa")) == Approx(1.0));
+}
+
+TEST_CASE("the run result survives the codec") {
+  auto s = make("{ cutoff: 10 m }");
+  auto direct = make("{ cutoff: 10 m }");
+  auto decoded = make("{ cutoff: 10 m }");
+  const auto& codec = dynamic_cast<const RunResultCodec&>(*s);
+  for (int run = 0; run < 3; ++run) {
+    test::start_run(*s, run);
+    step(*s, 1.0, {Vec3(0, 0, 0), Vec3(20, 0, 0)}, {track(1, Vec3(run, 1, 0))});
+    auto r = s->end_run();
+    std::string bytes;
+    ByteWriter w(bytes);
+    codec.save_run_result(*r, w);
+    ByteReader in(bytes.data(), bytes.size());
+    auto back = dynamic_cast<const RunResultCodec&>(*decoded).load_run_result(in);
+    CHECK(in.done());
+    direct->merge(*r);
+    decoded->merge(*back);
+  }
+  Summary a, b;
+  direct->finish(a, {});
+  decoded->finish(b, {});
+  REQUIRE(a.metrics.size() == b.metrics.size());
+  for (std::size_t i = 0; i < a.metrics.size(); ++i) {
+    CHECK(a.metrics[i].name == b.metrics[i].name);
+    CHECK(std::memcmp(&a.metrics[i].value, &b.metrics[i].value, sizeof(double)) == 0);
+  }
+  CHECK(a.series[0].values == b.series[0].values);
+}
+
+TEST_CASE("bad parameters are refused by name") {
+  auto refused = [](const std::string& yaml, const std::string& name) {
+    try {
+      test::make("sink.gospa", yaml);
+    } catch (const ConfigError& e) {
+      CHECK_THAT(std::string(e.what()), Catch::Contains(name));
+      return;
+    }
+    FAIL("accepted: " << yaml);
+  };
+  refused("{ cutoff: 0 m }", "cutoff");
+  refused("{ cutoff: 1 m, order: 0.5 }", "order");
+  refused("{ cutoff: 1 m, alpha: 3 }", "alpha");
+  refused("{ cutoff: 1 m, dimensions: 4 }", "dimensions");
+  refused("{ cutoff: 1 m, statuses: deleted }", "statuses");
+  refused("{ cutoff: 1 m, statuses: lost }", "statuses");
+  refused("{}", "cutoff");
+}
