@@ -484,11 +484,36 @@ PipelineConfig parse_pipeline(const Value& root, const std::string& file, const 
     if (it->params.kind != Value::Kind::Map) {
       it->params.kind = Value::Kind::Map;
     }
-    if (Value* existing = it->params.find(o.param)) {
+    // A dotted parameter reaches into a component-valued one: --set mtt.estimator.q=1 sets q in
+    // the map under 'estimator'. Every level but the last must already be a map in the file.
+    Value* target = &it->params;
+    std::string key = o.param;
+    for (std::size_t dot = key.find('.'); dot != std::string::npos; dot = key.find('.')) {
+      const std::string head = key.substr(0, dot);
+      Value* inner = target->find(head);
+      if (!inner) {
+        std::vector<std::string> keys;
+        for (const auto& e : target->entries) keys.push_back(e.first);
+        throw ConfigError("--set " + quote_token(o.node) + "." + quote_token(o.param) + ": node '" +
+                              quote_token(o.node) + "' sets no '" + quote_token(head) + "' to reach into" +
+                              did_you_mean(head, keys) + "; it sets: " + join_some(keys),
+                          it->loc, o.node);
+      }
+      if (inner->kind != Value::Kind::Map)
+        throw ConfigError("--set " + quote_token(o.node) + "." + quote_token(o.param) + ": '" + quote_token(head) +
+                              "' is not a map of parameters in node '" + quote_token(o.node) +
+                              "' (a dotted name reaches into a component, e.g. --set mtt.estimator.q=1)",
+                          inner->loc, o.node);
+      target = inner;
+      key = key.substr(dot + 1);
+    }
+    if (key.empty())
+      throw ConfigError("--set '" + quote_token(o.node) + "." + quote_token(o.param) + "': empty parameter name");
+    if (Value* existing = target->find(key)) {
       *existing = std::move(val);
     } else {
-      it->params.entries.emplace_back(o.param, std::move(val));
-      it->params.key_locs.push_back({"--set " + o.node + "." + o.param, 0, 0});
+      target->entries.emplace_back(key, std::move(val));
+      target->key_locs.push_back({"--set " + o.node + "." + o.param, 0, 0});
     }
   }
 

@@ -99,4 +99,30 @@ expect_run "a less_than reference to a missing metric is a config error" 2 "has 
 { base; printf 'expect:\n  score.position_rmse: { greater_than: score.velocity_rmse }\n  score.anees: { outside_band: 0.95 }\n'; } > "$TMP/expect_cmp.yaml"
 expect_run "greater_than and outside_band are evaluated" 1 "score.position_rmse = [0-9.]+ > score.velocity_rmse = [0-9.]+" \
   -- "$TF" run "$TMP/expect_cmp.yaml" --out "$TMP/out"
+# A dotted --set reaches into a component-valued parameter (tracker.multi's estimator, associator, ...).
+cat > "$TMP/tracker.yaml" <<'YAML'
+pipeline: { name: tracker_set, seed: 1, runs: 1 }
+nodes:
+  - id: scenario
+    type: sim.scenario
+    params: { duration: 3 s, region_lo: [0, 0, 0], region_hi: [100 m, 100 m, 10 m] }
+  - id: mtt
+    type: tracker.multi
+    input: scenario
+    params:
+      estimator: { type: filter.kalman, q: 1 m2/s3 }
+      associator: { type: assoc.gnn }
+      initiator: { type: init.m_of_n, max_speed: 20 m/s }
+      deleter: { type: delete.misses }
+YAML
+expect_run "--set into a component" 0 "ok" -- "$TF" validate "$TMP/tracker.yaml" --set mtt.estimator.q=4
+expect_run "--set into a component checks its unit" 2 "node 'mtt': parameter 'q' has unit dimension m2/s3, but '3 m' is m" \
+  -- "$TF" validate "$TMP/tracker.yaml" --set "mtt.estimator.q=3 m"
+expect_run "--set into a component: unknown parameter" 2 "node 'mtt': unknown parameter 'qq' \(did you mean 'q'\?\)" \
+  -- "$TF" validate "$TMP/tracker.yaml" --set mtt.estimator.qq=4
+expect_run "--set into a misspelt component" 2 "tracker.yaml:6:5: node 'mtt': --set mtt.estimatr.q: node 'mtt' sets no 'estimatr' to reach into \(did you mean 'estimator'\?\)" \
+  -- "$TF" validate "$TMP/tracker.yaml" --set mtt.estimatr.q=4
+expect_run "--set into a scalar" 2 "'max_speed' is not a map|'deleter' is|sets no 'max_tracks'" \
+  -- "$TF" validate "$TMP/tracker.yaml" --set mtt.max_tracks.q=4
+
 finish

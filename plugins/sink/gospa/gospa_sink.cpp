@@ -290,13 +290,16 @@ class GospaSink final : public Component, public FieldListCodec<GospaRunResult> 
     out.add_column("runs");
     const std::string unit_p = gospa_.order() == 1.0 ? "m" : gospa_.order() == 2.0 ? "m2" : "";
     const std::string units[10] = {"m", unit_p, "m", unit_p, unit_p, unit_p, "", "", "", ""};
-    for (int i = 0; i < 10; ++i) out.add_column(kNames[i], units[i]);
+    // Without alpha = 2 there is no decomposition: its three columns are left out, not filled with NaN.
+    auto has_column = [parts](int i) { return parts || i < 3 || i > 5; };
+    for (int i = 0; i < 10; ++i)
+      if (has_column(i)) out.add_column(kNames[i], units[i]);
     out.values.reserve(steps_by_time_.size() * out.columns.size());
     for (const auto& [key, st] : steps_by_time_) {
       out.values.push_back(st.time);
       out.values.push_back(static_cast<double>(st.runs));
       for (int i = 0; i < 10; ++i)
-        out.values.push_back(!parts && i >= 3 && i <= 5 ? kNaN : st.v[i] / static_cast<double>(st.runs));
+        if (has_column(i)) out.values.push_back(st.v[i] / static_cast<double>(st.runs));
     }
     return out;
   }

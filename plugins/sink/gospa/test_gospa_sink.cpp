@@ -158,6 +158,23 @@ TEST_CASE("merged runs give the mean of the runs, and a series") {
   CHECK(ser.at(1, ser.column("gospa")) == Approx(1.0));
 }
 
+TEST_CASE("alpha other than 2: no decomposition, and no NaN anywhere in the series") {
+  auto s = make("{ cutoff: 10 m, alpha: 1 }");
+  test::start_run(*s);
+  step(*s, 1.0, {Vec3(0, 0, 0)}, {});  // one missed target: d = (c^p / alpha)^(1/p) = 10
+  auto r = s->end_run();
+  s->merge(*r);
+  Summary sum;
+  s->finish(sum, {});
+  CHECK(metric(sum, "gospa") == Approx(10.0));
+  CHECK(sum.find("gospa_missed") == nullptr);
+  REQUIRE(sum.series.size() == 1);
+  const Series& ser = sum.series[0];
+  for (const auto& c : ser.columns) CHECK(c.name != "gospa_missed");
+  for (double v : ser.values) CHECK(std::isfinite(v));
+  CHECK(ser.values.size() == ser.columns.size() * ser.rows());
+}
+
 TEST_CASE("the run result survives the codec") {
   auto s = make("{ cutoff: 10 m }");
   auto direct = make("{ cutoff: 10 m }");
