@@ -69,7 +69,9 @@ inline std::shared_ptr<Component> make(const host::PluginRegistry& reg, const st
     std::exit(2);
   }
   host::Value v = host::load_yaml_string(yaml, "bench");
-  return reg.create(*t, host::validate_params(t->decl.params, v, type, v.loc));
+  host::ComponentTypes types;  // what component-valued parameters (a tracker's estimator, ...) may name
+  for (const auto& rt : reg.types()) types.push_back(&rt.decl);
+  return reg.create(*t, host::validate_params(t->decl.params, v, type, v.loc, types));
 }
 
 }  // namespace trackflow::bench

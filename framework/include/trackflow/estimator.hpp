@@ -48,6 +48,13 @@ class TrackContext {
   std::string who;  // "filter.kalman (node 'kf')", for messages
 
  protected:
+  // Declared so that a derived context (a tracker's track slot) moves without copying `who`: a
+  // user-declared destructor alone would suppress the implicit moves.
+  TrackContext() = default;
+  TrackContext(const TrackContext&) = default;
+  TrackContext(TrackContext&&) noexcept = default;
+  TrackContext& operator=(const TrackContext&) = default;
+  TrackContext& operator=(TrackContext&&) noexcept = default;
   ~TrackContext() = default;
 };
 

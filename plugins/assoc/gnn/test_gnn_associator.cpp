@@ -172,4 +172,15 @@ TEST_CASE("gnn weighs detection against miss") {
   CHECK_THROWS_AS(gnn("{}")->associate(p.tracks, p.scan, out), DataError);
   gnn("{ clutter_density: 1e-6 1/m3 }")->associate(p.tracks, p.scan, out);
   CHECK(out[0] == 0);
+  // Parameters, when given, override what the scan states (a mismatched model of the sensor).
+  p.scan.clutter_density = 1e-6;
+  gnn("{ clutter_density: 8e-4 1/m3 }")->associate(p.tracks, p.scan, out);
+  CHECK(out[0] == -1);
+  // P_D: with lambda = 4e-4 the detection wins at the scan's P_D 0.9 (above); an assumed P_D of 0.5
+  // gives P_D g / (1 - P_D P_G) = 6.8e-5 < lambda: the miss wins.
+  p.scan.clutter_density = 4e-4;
+  gnn("{}")->associate(p.tracks, p.scan, out);
+  CHECK(out[0] == 0);
+  gnn("{ detection_probability: 0.5 }")->associate(p.tracks, p.scan, out);
+  CHECK(out[0] == -1);
 }

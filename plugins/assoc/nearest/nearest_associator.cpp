@@ -1,5 +1,5 @@
 // Purpose: assoc.nearest — the naive baseline: gated track-detection pairs taken greedily in order of increasing NIS, each track and detection once.
-#include "association/gating.hpp"
+#include "association/gated_pairs.hpp"
 
 #include <trackflow/chi_square.hpp>
 #include <trackflow/plugin.hpp>
@@ -16,19 +16,12 @@ namespace {
 
 class NearestAssociator final : public Associator {
  public:
-  explicit NearestAssociator(double gate_probability) : gate_probability_(gate_probability) {}
+  explicit NearestAssociator(double gate_probability) : gated_(gate_probability) {}
 
   void associate(std::span<const TrackView> tracks, const Scan& scan, std::span<int> detection_of_track) override {
+    for (size_t i = 0; i < tracks.size(); ++i) detection_of_track[i] = -1;
     pairs_.clear();
-    for (size_t i = 0; i < tracks.size(); ++i) {
-      detection_of_track[i] = -1;
-      if (!tracks[i].predicted || !gate_.set(*tracks[i].predicted, scan.sensor.frame)) continue;
-      const double gamma = chi_square_quantile(gate_.dim(), gate_probability_);
-      for (size_t j = 0; j < scan.detections.size(); ++j) {
-        const double nis = gate_.nis(scan.detections[j].value);
-        if (nis <= gamma) pairs_.push_back({nis, static_cast<int>(i), static_cast<int>(j)});
-      }
-    }
+    for (const association::GatedPair& g : gated_.find(tracks, scan)) pairs_.push_back({g.nis, g.track, g.detection});
     // Smallest NIS first; ties by track, then detection, so the result never depends on sort order.
     std::sort(pairs_.begin(), pairs_.end(), [](const Pair& a, const Pair& b) {
       return std::tie(a.nis, a.track, a.detection) < std::tie(b.nis, b.track, b.detection);
@@ -46,8 +39,7 @@ class NearestAssociator final : public Associator {
     double nis;
     int track, detection;
   };
-  double gate_probability_;
-  association::PredictedGate gate_;
+  association::GatedPairs gated_;
   std::vector<Pair> pairs_;
   std::vector<char> taken_;
 };

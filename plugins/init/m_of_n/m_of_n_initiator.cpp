@@ -1,10 +1,13 @@
 // Purpose: init.m_of_n — two-point track initiation: a detection no track took pairs with one of the previous scan's within the distance a target can cover (max_speed) plus the measurement errors; the track is confirmed with M hits in its first N looks, or fails.
-#include "assignment/linear_assignment.hpp"
+#include "assignment/sparse_assignment.hpp"
+#include "memory/grow.hpp"
+#include "association/point_grid.hpp"
 
 #include <trackflow/geometry.hpp>
 #include <trackflow/plugin.hpp>
 #include <trackflow/tracker.hpp>
 
+#include <algorithm>
 #include <bit>
 #include <cmath>
 #include <limits>
@@ -59,28 +62,45 @@ class MofNInitiator final : public Initiator {
       to_measurement(scan, scan.detections[static_cast<size_t>(j)], m);
       current_.push_back({m, locate(m), j});
     }
-    const int rows = static_cast<int>(pending_.size()), m = static_cast<int>(current_.size()), cols = m + rows;
-    used_.assign(current_.size(), 0);
+    const int rows = static_cast<int>(pending_.size()), m = static_cast<int>(current_.size());
+    memory::assign_grown(used_, current_.size(), char{0});
     if (rows > 0 && m > 0) {
-      cost_.assign(static_cast<size_t>(rows) * static_cast<size_t>(cols), kInf);
-      for (int i = 0; i < rows; ++i) {
-        const Candidate& a = pending_[static_cast<size_t>(i)];
-        double* row = cost_.data() + static_cast<size_t>(i) * static_cast<size_t>(cols);
-        for (int j = 0; j < m; ++j) {
-          const Candidate& b = current_[static_cast<size_t>(j)];
+      // Pre-gate: the previous detections in a grid over (x, y); each current one looks in the box
+      // of its widest possible gate (the largest previous sigma, the earliest previous time), then
+      // tests each candidate's own gate exactly. The cell side is the median box width.
+      double sigma_max = 0.0, t_min = pending_.front().m.time;
+      points_.resize(pending_.size());
+      for (std::size_t i = 0; i < pending_.size(); ++i) {
+        sigma_max = std::max(sigma_max, pending_[i].where.sigma);
+        t_min = std::min(t_min, pending_[i].m.time);
+        points_[i] = pending_[i].where.position.head<2>();
+      }
+      reach_.resize(current_.size());
+      for (std::size_t j = 0; j < current_.size(); ++j)
+        reach_[j] = s_.max_speed * (current_[j].m.time - t_min) + s_.sigmas * std::hypot(sigma_max, current_[j].where.sigma);
+      memory::reserve_grown(widths_, reach_.size());
+      widths_.assign(reach_.begin(), reach_.end());
+      const auto mid = widths_.begin() + static_cast<std::ptrdiff_t>(widths_.size() / 2);
+      std::nth_element(widths_.begin(), mid, widths_.end());
+      grid_.build(points_, 2.0 * *mid);
+      problem_.clear(rows, m);
+      for (int i = 0; i < rows; ++i) problem_.set_none_cost(i, 1.0);
+      for (int j = 0; j < m; ++j) {
+        const Candidate& b = current_[static_cast<size_t>(j)];
+        const Eigen::Vector2d half = Eigen::Vector2d::Constant(reach_[static_cast<size_t>(j)]);
+        const Eigen::Vector2d centre = b.where.position.head<2>();
+        grid_.for_each_candidate(centre - half, centre + half, [&](int i) {
+          const Candidate& a = pending_[static_cast<size_t>(i)];
           const double T = b.m.time - a.m.time;
           const double gate = s_.max_speed * T + s_.sigmas * std::hypot(a.where.sigma, b.where.sigma);
           const double d = (b.where.position - a.where.position).norm();
-          if (T > 0.0 && d <= gate) row[j] = d / gate;  // relative: a pair at the gate's edge costs the "no pair" 1
-        }
-        row[m + i] = 1.0;
+          if (T > 0.0 && d <= gate) problem_.add(i, j, d / gate);  // relative: a pair at the gate's edge costs the "no pair" 1
+        });
       }
-      solver_.reserve(rows, cols);
-      const assignment::AssignmentResult r = solver_.solve(std::span<const double>(cost_), rows, cols);
-      for (int i = 0; r.feasible && i < rows; ++i) {
-        const int c = r.column_for_row[static_cast<size_t>(i)];
-        if (c < 0 || c >= m || !std::isfinite(cost_[static_cast<size_t>(i) * static_cast<size_t>(cols) + static_cast<size_t>(c)]))
-          continue;
+      const std::span<const int> col = problem_.solve();
+      for (int i = 0; i < rows; ++i) {
+        const int c = col[static_cast<size_t>(i)];
+        if (c < 0) continue;
         starts.push_back({pending_[static_cast<size_t>(i)].m, current_[static_cast<size_t>(c)].detection});
         used_[static_cast<size_t>(c)] = 1;
       }
@@ -96,7 +116,6 @@ class MofNInitiator final : public Initiator {
   bool failed(const TrackView& t) const override { return t.looks >= s_.n && !confirmed(t); }
 
  private:
-  static constexpr double kInf = std::numeric_limits<double>::infinity();
   struct Candidate {
     Measurement m;
     Located where;
@@ -105,8 +124,10 @@ class MofNInitiator final : public Initiator {
   MofNSettings s_;
   std::vector<Candidate> pending_, current_;
   std::vector<char> used_;
-  std::vector<double> cost_;
-  assignment::LinearAssignment solver_;
+  std::vector<Eigen::Vector2d> points_;
+  std::vector<double> reach_, widths_;
+  association::PointGrid grid_;
+  assignment::SparseAssignment problem_;
 };
 
 std::unique_ptr<TrackerPart> create_part(const Params& p) {

@@ -1,7 +1,8 @@
 // Purpose: GOSPA (and OSPA) between truth and track positions, by optimal assignment on cut-off distances.
 #pragma once
 
-#include "assignment/linear_assignment.hpp"
+#include "assignment/sparse_assignment.hpp"
+#include "memory/grow.hpp"
 
 #include <Eigen/Core>
 
@@ -56,8 +57,9 @@ struct GospaResult {
 // The minimising pi is the one GOSPA's Eq. (1) needs (the penalty term does not depend on pi),
 // so one assignment gives both.
 //
-// The optimal pi comes from the linear assignment solver on the |X| x |Y| matrix of
-// d^(c)(x_i, y_j)^p. Cut-off, order and alpha are checked once (c > 0, 1 <= p, 0 < alpha <= 2,
+// The optimal pi comes from the clustered sparse assignment over the pairs closer than c
+// (evaluate() says how; equal to the linear assignment of the |X| x |Y| matrix of d^(c)(x_i, y_j)^p,
+// which the brute-force tests check). Cut-off, order and alpha are checked once (c > 0, 1 <= p, 0 < alpha <= 2,
 // all finite); non-finite positions are refused with std::invalid_argument. After reserve() an
 // evaluate() of sets no larger allocates nothing.
 class Gospa {
@@ -73,8 +75,7 @@ class Gospa {
   }
 
   void reserve(int truths, int tracks) {
-    solver_.reserve(truths, tracks);
-    cost_.reserve(static_cast<std::size_t>(truths) * static_cast<std::size_t>(tracks));
+    problem_.clear(truths, tracks);
     track_for_truth_.reserve(static_cast<std::size_t>(truths));
   }
 
@@ -92,34 +93,46 @@ class Gospa {
     const int nx = static_cast<int>(truth.size());
     const int ny = static_cast<int>(tracks.size());
 
-    cost_.resize(static_cast<std::size_t>(nx) * static_cast<std::size_t>(ny));
+    // The optimal injection pi of Eq. (1) pairs some elements closer than c and leaves the rest at
+    // the clipped cost c^p, so it is found as a partial assignment gamma over the pairs closer than
+    // c, each priced d^p - c^p (what it saves against c^p), every truth with "no track" at 0:
+    //   min_pi sum min(d, c)^p = c^p min(|X|, |Y|) + min_gamma sum_gamma (d^p - c^p).
+    // Only pairs closer than c enter, and the problem splits into clusters (sparse_assignment.hpp).
+    // The totals are then summed from the chosen pairs themselves (no cancellation against c^p).
+    problem_.clear(nx, ny);
     for (int i = 0; i < nx; ++i)
-      for (int j = 0; j < ny; ++j)
-        cost_[index(i, j, ny)] = clipped_pow((truth[static_cast<std::size_t>(i)] - tracks[static_cast<std::size_t>(j)]).norm());
-    const assignment::AssignmentResult pi = solver_.solve(cost_, nx, ny);
-    if (!pi.feasible) throw std::logic_error("gospa: assignment of finite costs reported infeasible");
+      for (int j = 0; j < ny; ++j) {
+        const double d = (truth[static_cast<std::size_t>(i)] - tracks[static_cast<std::size_t>(j)]).norm();
+        if (d < cutoff_) {
+          const double dp = clipped_pow(d);
+          if (dp < cutoff_pow_p_) problem_.add(i, j, dp - cutoff_pow_p_);
+        }
+      }
+    const std::span<const int> chosen = problem_.solve();
+
+    memory::assign_grown(track_for_truth_, static_cast<std::size_t>(nx), -1);
+    GospaDecomposition parts;
+    for (int i = 0; i < nx; ++i) {
+      const int j = chosen[static_cast<std::size_t>(i)];
+      if (j < 0) continue;
+      track_for_truth_[static_cast<std::size_t>(i)] = j;
+      parts.localisation +=
+          clipped_pow((truth[static_cast<std::size_t>(i)] - tracks[static_cast<std::size_t>(j)]).norm());
+      ++parts.detected;
+    }
+    const int smaller = nx < ny ? nx : ny;
+    const double assignment_cost = parts.localisation + cutoff_pow_p_ * (smaller - parts.detected);
 
     // Eq. (1): the assignment's cost plus c^p / alpha per element of the larger set left over.
     const int unmatched = nx > ny ? nx - ny : ny - nx;
     const int larger = nx > ny ? nx : ny;
     GospaResult r;
-    r.gospa_pow_p = pi.total_cost + cutoff_pow_p_ / alpha_ * unmatched;
+    r.gospa_pow_p = assignment_cost + cutoff_pow_p_ / alpha_ * unmatched;
     r.gospa = root_p(r.gospa_pow_p);
-    r.ospa = larger == 0 ? 0.0 : root_p((pi.total_cost + cutoff_pow_p_ * unmatched) / larger);
+    r.ospa = larger == 0 ? 0.0 : root_p((assignment_cost + cutoff_pow_p_ * unmatched) / larger);
 
-    // Proposition 1: keep only the pairs closer than c; the others are a missed and a false
-    // target each (c^p / 2 + c^p / 2, the c^p they cost as clipped pairs).
-    track_for_truth_.assign(static_cast<std::size_t>(nx), -1);
-    GospaDecomposition parts;
-    for (int i = 0; i < nx; ++i) {
-      const int j = pi.column_for_row[static_cast<std::size_t>(i)];
-      if (j < 0) continue;
-      const double d = (truth[static_cast<std::size_t>(i)] - tracks[static_cast<std::size_t>(j)]).norm();
-      if (!(d < cutoff_)) continue;
-      track_for_truth_[static_cast<std::size_t>(i)] = j;
-      parts.localisation += cost_[index(i, j, ny)];
-      ++parts.detected;
-    }
+    // Proposition 1: the pairs of gamma are those closer than c; every other truth is missed and
+    // every other track false (c^p / 2 each: a clipped pair's c^p split in two).
     if (alpha_ == 2.0) {
       parts.missed_count = nx - parts.detected;
       parts.false_count = ny - parts.detected;
@@ -140,10 +153,6 @@ class Gospa {
   }
 
  private:
-  static std::size_t index(int i, int j, int cols) {
-    return static_cast<std::size_t>(i) * static_cast<std::size_t>(cols) + static_cast<std::size_t>(j);
-  }
-
   // d^(c)^p, with p = 1 and p = 2 done without pow so that the common orders are exact to the
   // last bit of the distance.
   double clipped_pow(double d) const {
@@ -170,8 +179,7 @@ class Gospa {
   double order_;
   double alpha_;
   double cutoff_pow_p_ = 0.0;
-  assignment::LinearAssignment solver_;
-  std::vector<double> cost_;
+  assignment::SparseAssignment problem_;
   std::vector<int> track_for_truth_;
 };
 

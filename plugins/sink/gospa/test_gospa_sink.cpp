@@ -158,7 +158,7 @@ TEST_CASE("merged runs give the mean of the runs, and a series") {
   CHECK(ser.at(1, ser.column("gospa")) == Approx(1.0));
 }
 
-TEST_CASE("alpha other than 2: no decomposition, and no NaN anywhere in the series") {
+TEST_CASE("alpha other than 2: no parts, and no NaN in the series") {
   auto s = make("{ cutoff: 10 m, alpha: 1 }");
   test::start_run(*s);
   step(*s, 1.0, {Vec3(0, 0, 0)}, {});  // one missed target: d = (c^p / alpha)^(1/p) = 10

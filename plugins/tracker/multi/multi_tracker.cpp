@@ -1,4 +1,6 @@
 // Purpose: tracker.multi — a multi-target tracker composed of parts: per scan it predicts every track, lets the associator give detections to tracks, updates, confirms and deletes (initiator, deleter), starts tracks from what no track took (initiator), and publishes one TrackSet.
+#include "memory/grow.hpp"
+
 #include <trackflow/component.hpp>
 #include <trackflow/error.hpp>
 #include <trackflow/estimate_state.hpp>
@@ -80,6 +82,8 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
   void start_run(const RunContext& ctx) override {
     diag_ = ctx.diagnostics;
     run_ = TrackerRunResult{};
+    // The last run's slots become spares: their estimators' storage serves this run's tracks.
+    for (Track& t : tracks_) spare_.push_back(std::move(t));
     tracks_.clear();
     next_id_ = 1;
     has_time_ = false;
@@ -198,8 +202,8 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
   }
 
   void associate(const Scan& s) {
-    assigned_.assign(tracks_.size(), -1);
-    taken_.assign(s.detections.size(), 0);
+    memory::assign_grown(assigned_, tracks_.size(), -1);
+    memory::assign_grown(taken_, s.detections.size(), char{0});
     if (tracks_.empty() || s.detections.empty()) return;
     associator_->associate(views_, s, assigned_);
     for (size_t i = 0; i < assigned_.size(); ++i) {
@@ -319,14 +323,15 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
   Track& new_track() {
     if (spare_.empty()) {
       tracks_.emplace_back();
-      tracks_.back().estimator = prototype_->clone();
+      Track& fresh = tracks_.back();
+      fresh.estimator = prototype_->clone();
+      fresh.who = "tracker.multi (node '" + node_ + "') track";  // once per slot: a reused one keeps it
+      fresh.warnings = &warnings_;
     } else {
       tracks_.push_back(std::move(spare_.back()));
       spare_.pop_back();
     }
     Track& t = tracks_.back();
-    t.who = "tracker.multi (node '" + node_ + "') track";
-    t.warnings = &warnings_;
     rebind(t);
     return t;
   }
@@ -359,11 +364,18 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
     }
     run_.confirmed_track_scans += confirmed;
     out.emit(TrackSet{t, set_});
-    for (size_t i = tracks_.size(); i-- > 0;) {
-      if (tracks_[i].published.status != TrackStatus::Deleted) continue;
-      spare_.push_back(std::move(tracks_[i]));
-      tracks_.erase(tracks_.begin() + static_cast<std::ptrdiff_t>(i));
+    // Deleted slots go to the spares in one pass (an erase per deletion would shift the whole
+    // tail each time: quadratic in the population, and a slot is kilobytes).
+    std::size_t kept = 0;
+    for (std::size_t i = 0; i < tracks_.size(); ++i) {
+      if (tracks_[i].published.status == TrackStatus::Deleted) {
+        spare_.push_back(std::move(tracks_[i]));
+      } else {
+        if (kept != i) tracks_[kept] = std::move(tracks_[i]);
+        ++kept;
+      }
     }
+    tracks_.erase(tracks_.begin() + static_cast<std::ptrdiff_t>(kept), tracks_.end());
   }
 
   void report_warnings() {
