@@ -83,7 +83,7 @@ double check(const Problem& p, std::span<const int> col, double reported) {
 
 }  // namespace
 
-TEST_CASE("equals the dense problem and brute force on 6000 random problems up to 8x8") {
+TEST_CASE("= dense and brute force on 6000 problems up to 8x8") {
   std::mt19937_64 rng(21);
   SparseAssignment sparse;
   LinearAssignment dense_solver;
@@ -129,7 +129,7 @@ TEST_CASE("equals the dense problem on large sparse problems") {
   }
 }
 
-TEST_CASE("the answer does not depend on the order of the pairs, and duplicates count once at their cheaper cost") {
+TEST_CASE("pair order does not matter, duplicates count cheaper") {
   std::mt19937_64 rng(8);
   SparseAssignment a, b;
   for (int k = 0; k < 500; ++k) {
@@ -149,7 +149,7 @@ TEST_CASE("the answer does not depend on the order of the pairs, and duplicates 
   }
 }
 
-TEST_CASE("hand-worked: two rows competing for one column, and an isolated row") {
+TEST_CASE("hand-worked: two rows compete for one column") {
   SparseAssignment s;
   s.clear(3, 2);
   s.set_none_cost(0, 5.0);

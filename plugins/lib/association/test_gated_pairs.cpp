@@ -74,7 +74,7 @@ std::vector<std::tuple<int, int, double>> all_pairs(const World& w, double pg) {
 
 }  // namespace
 
-TEST_CASE("the grid pre-gate finds exactly the pairs of the all-pairs test, with the same NIS") {
+TEST_CASE("grid pre-gate = all-pairs test: same pairs, same NIS") {
   std::mt19937_64 rng(4);
   std::size_t total = 0;
   for (Frame frame : {Frame::Cartesian, Frame::Spherical}) {

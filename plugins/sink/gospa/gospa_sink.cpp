@@ -1,6 +1,8 @@
 // Purpose: sink.gospa — GOSPA (with its localisation / missed / false parts for alpha = 2) and OSPA between truth and a tracker's track sets, per scan, Monte Carlo means and a per-step series.
 #include "scoring/gospa.hpp"
+#include "scoring/track_set_sink.hpp"
 
+#include <trackflow/number_text.hpp>
 #include <trackflow/plugin.hpp>
 #include <trackflow/run_result_codec.hpp>
 #include <trackflow/tracks.hpp>
@@ -78,53 +80,18 @@ constexpr const char* kNames[10] = {"gospa",          "gospa_pow_p",    "ospa", 
 
 enum class Dims { Two = 2, Three = 3 };
 
-std::uint8_t parse_statuses(const Params& p) {
-  std::string text = p.text("statuses");
-  for (char& c : text)
-    if (c == ',' || c == '[' || c == ']') c = ' ';
-  std::istringstream is(text);
-  std::uint8_t m = 0;
-  for (std::string w; is >> w;) {
-    if (w == "tentative") m |= 1u << static_cast<int>(TrackStatus::Tentative);
-    else if (w == "confirmed") m |= 1u << static_cast<int>(TrackStatus::Confirmed);
-    else if (w == "coasting") m |= 1u << static_cast<int>(TrackStatus::Coasting);
-    else if (w == "deleted")
-      throw p.error("statuses", "'deleted' cannot be scored: a deleted track is no estimate (give tentative, confirmed, coasting)");
-    else
-      throw p.error("statuses", "unknown status '" + w + "' (give some of tentative, confirmed, coasting)");
-  }
-  if (!m) throw p.error("statuses", "give at least one of tentative, confirmed, coasting");
-  return m;
-}
-
-Dims parse_dims(const Params& p) {
-  const long long d = p.integer("dimensions");
-  if (d != 2 && d != 3) throw p.error("dimensions", "must be 2 (planar, x-y) or 3, not " + std::to_string(d));
-  return static_cast<Dims>(d);
-}
-
 // Streams: truths of one time are kept until the next time's; each TrackSet is scored on arrival
 // against the truths of exactly its time stamp. Buffers keep their capacity between scans and runs.
 class GospaSink final : public Component, public FieldListCodec<GospaRunResult> {
  public:
   explicit GospaSink(const Params& p)
       : gospa_(p.real("cutoff"), p.real("order"), p.real("alpha")),
-        statuses_(parse_statuses(p)),
-        dims_(parse_dims(p)),
+        statuses_(scoring::parse_track_statuses(p)),
+        dims_(scoring::planar_dimensions(p) ? Dims::Two : Dims::Three),
         skip_initial_(p.real("skip_initial")),
         series_(p.boolean("series")) {}
 
-  void set_inputs(const std::vector<InputInfo>& inputs) override {
-    int tracks = 0, truths = 0;
-    for (const auto& in : inputs) {
-      tracks += (in.kinds & mask(ItemKind::Tracks)) ? 1 : 0;
-      truths += (in.kinds & mask(ItemKind::Truth)) ? 1 : 0;
-    }
-    if (tracks != 1 || truths < 1)
-      throw ConfigError("sink.gospa: needs one input of track sets (a tracker) and truth, e.g. inputs: [tracker, "
-                        "scenario]; got " + std::to_string(tracks) + " of tracks and " + std::to_string(truths) +
-                        " of truth");
-  }
+  void set_inputs(const std::vector<InputInfo>& inputs) override { scoring::check_track_set_inputs(inputs, "sink.gospa"); }
 
   void start_run(const RunContext&) override {
     run_.steps = 0;
@@ -167,7 +134,7 @@ class GospaSink final : public Component, public FieldListCodec<GospaRunResult> 
     track3_.clear();
     track2_.clear();
     for (const TrackEstimate& te : set.tracks) {
-      if (!(statuses_ & (1u << static_cast<int>(te.status))) || !te.estimate.initialised) continue;
+      if (!scoring::status_selected(statuses_, te.status) || !te.estimate.initialised) continue;
       const Vec3 pos = te.estimate.enu.head<3>();
       if (dims_ == Dims::Three ? !pos.allFinite() : !pos.head<2>().allFinite()) {
         ++run_.non_finite_tracks;
@@ -264,8 +231,8 @@ class GospaSink final : public Component, public FieldListCodec<GospaRunResult> 
     s.metric("unscored_truth_steps", static_cast<double>(unscored_truth_steps_));
     s.metric("steps_without_truth", static_cast<double>(steps_without_truth_));
     s.notes.push_back(
-        "GOSPA (c = " + std::to_string(gospa_.cutoff()) + " m, p = " + std::to_string(gospa_.order()) +
-        ", alpha = " + std::to_string(gospa_.alpha()) + ") per TrackSet against the truths of exactly its time; " +
+        "GOSPA (c = " + number_text::general(gospa_.cutoff(), 6) + " m, p = " + number_text::general(gospa_.order(), 6) +
+        ", alpha = " + number_text::general(gospa_.alpha(), 6) + ") per TrackSet against the truths of exactly its time; " +
         "gospa: mean over a run's steps of d, then over runs; gospa_pow_p: the same of d^p" +
         (parts ? ", = gospa_localisation + gospa_missed + gospa_false (means of the p-th-power parts)" : "") +
         "; missed_targets / false_tracks: per step, truths / tracks without a partner closer than c");
@@ -346,14 +313,9 @@ void register_components(Registrar& r) {
           .def("2")
           .positive()
           .at_most(2),
-      ParamSpec::string("statuses", "track statuses scored, some of tentative, confirmed, coasting")
-          .def("confirmed, coasting"),
-      ParamSpec::real("skip_initial", dim::time, "leave out track sets earlier than the first one + this (transient)")
-          .def("0 s")
-          .at_least(0),
-      ParamSpec::integer("dimensions", "3: x-y-z; 2: planar scoring on x-y").def("3"),
       ParamSpec::boolean("series", "publish the per-step series (kept per step in each run)").def("true"),
   };
+  for (ParamSpec& spec : scoring::track_set_params()) d.params.push_back(std::move(spec));
   d.accepts = ItemKind::Tracks | ItemKind::Truth;
   d.min_inputs = 2;
   d.max_inputs = -1;

@@ -1,0 +1,275 @@
+// Purpose: sink.track_quality — how well a tracker's tracks follow the truths over time: completeness, spuriousness, identity swaps, track breaks, establishment time, tracks never on a target.
+#include "memory/grow.hpp"
+#include "scoring/gospa.hpp"
+#include "scoring/track_set_sink.hpp"
+
+#include <trackflow/number_text.hpp>
+#include <trackflow/plugin.hpp>
+#include <trackflow/run_result_codec.hpp>
+#include <trackflow/tracks.hpp>
+
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+namespace trackflow {
+namespace {
+
+// Sums of one run (and, merged, of all runs).
+struct QualityRunResult final : RunResult {
+  std::uint64_t steps = 0;
+  std::uint64_t truth_steps = 0, tracked_truth_steps = 0;  // completeness = tracked / truth steps
+  std::uint64_t track_steps = 0, spurious_track_steps = 0;  // spuriousness = spurious / track steps
+  std::uint64_t id_swaps = 0, breaks = 0;
+  std::uint64_t targets = 0, targets_established = 0;
+  double establishment_time_sum = 0.0;  // over the established targets
+  std::uint64_t tracks = 0, tracks_never_on_a_target = 0;
+  std::uint64_t non_finite = 0, unscored_truth_steps = 0, steps_without_truth = 0, ids_out_of_range = 0;
+  template <class Self, class F>
+  static void fields(Self& r, F&& f) {
+    f(r.steps, r.truth_steps, r.tracked_truth_steps, r.track_steps, r.spurious_track_steps, r.id_swaps, r.breaks,
+      r.targets, r.targets_established, r.establishment_time_sum, r.tracks, r.tracks_never_on_a_target, r.non_finite,
+      r.unscored_truth_steps, r.steps_without_truth, r.ids_out_of_range);
+  }
+};
+
+// What is kept per truth target and per track id within a run (indexed by id: simulations and
+// trackers number them densely from 0 and 1).
+struct TargetState {
+  bool seen = false, established = false, tracked_last_step = false;
+  double first_time = 0.0;
+  std::uint64_t last_track = 0;  // id of the last track that followed it (0: none yet)
+};
+struct TrackState {
+  bool seen = false, on_a_target = false;
+};
+
+// Ids beyond this are refused per item (counted): a vector indexed by id must stay bounded.
+constexpr std::uint64_t kMaxId = 1u << 24;
+
+class TrackQualitySink final : public Component, public FieldListCodec<QualityRunResult> {
+ public:
+  explicit TrackQualitySink(const Params& p)
+      : gospa_(p.real("cutoff"), 2.0, 2.0),
+        statuses_(scoring::parse_track_statuses(p)),
+        planar_(scoring::planar_dimensions(p)),
+        skip_initial_(p.real("skip_initial")) {}
+
+  void set_inputs(const std::vector<InputInfo>& inputs) override {
+    scoring::check_track_set_inputs(inputs, "sink.track_quality");
+  }
+
+  void start_run(const RunContext&) override {
+    run_ = QualityRunResult{};
+    targets_.clear();
+    track_state_.clear();
+    truth_pos_.clear();
+    truth_ids_.clear();
+    have_batch_ = batch_used_ = false;
+    first_set_ = std::numeric_limits<double>::quiet_NaN();
+  }
+
+  void on_truth(const Truth& t, int) override {
+    if (!have_batch_ || t.time != batch_time_) {
+      if (have_batch_ && !batch_used_) ++run_.unscored_truth_steps;
+      have_batch_ = true;
+      batch_used_ = false;
+      batch_time_ = t.time;
+      truth_pos_.clear();
+      truth_ids_.clear();
+    }
+    if (!t.position.allFinite()) {
+      ++run_.non_finite;
+      return;
+    }
+    if (t.target >= kMaxId) {
+      ++run_.ids_out_of_range;
+      return;
+    }
+    truth_pos_.push_back(position(t.position));
+    truth_ids_.push_back(t.target);
+  }
+
+  void on_tracks(const TrackSet& set, int) override {
+    if (std::isnan(first_set_)) first_set_ = set.time;
+    const bool truth_now = have_batch_ && batch_time_ == set.time;
+    if (truth_now) batch_used_ = true;
+    if (set.time < first_set_ + skip_initial_) return;
+    track_pos_.clear();
+    track_ids_.clear();
+    for (const TrackEstimate& te : set.tracks) {
+      if (!scoring::status_selected(statuses_, te.status) || !te.estimate.initialised) continue;
+      const Eigen::Vector3d p = position(te.estimate.enu.head<3>());
+      if (!p.allFinite()) {
+        ++run_.non_finite;
+        continue;
+      }
+      if (te.id >= kMaxId) {
+        ++run_.ids_out_of_range;
+        continue;
+      }
+      track_pos_.push_back(p);
+      track_ids_.push_back(te.id);
+    }
+    if (!truth_now) {
+      ++run_.steps_without_truth;
+      truth_pos_.clear();
+      truth_ids_.clear();
+    }
+    // Which track follows which truth: GOSPA's optimal assignment, pairs closer than the cut-off.
+    const metrics::GospaResult g = gospa_.evaluate<3>(std::span<const Eigen::Vector3d>(truth_pos_),
+                                                      std::span<const Eigen::Vector3d>(track_pos_));
+    ++run_.steps;
+    run_.truth_steps += truth_pos_.size();
+    run_.track_steps += track_pos_.size();
+    memory::assign_grown(track_on_target_, track_pos_.size(), char{0});
+    for (std::size_t i = 0; i < truth_ids_.size(); ++i) {
+      TargetState& ts = target(truth_ids_[i]);
+      if (!ts.seen) {
+        ts.seen = true;
+        ts.first_time = set.time;
+        ++run_.targets;
+      }
+      const int j = g.track_for_truth[i];
+      if (j < 0) {
+        if (ts.tracked_last_step) ++run_.breaks;  // it had a track at its previous step
+        ts.tracked_last_step = false;
+        continue;
+      }
+      const std::uint64_t id = track_ids_[static_cast<std::size_t>(j)];
+      track_on_target_[static_cast<std::size_t>(j)] = 1;
+      ++run_.tracked_truth_steps;
+      if (!ts.established) {
+        ts.established = true;
+        ++run_.targets_established;
+        run_.establishment_time_sum += set.time - ts.first_time;
+      }
+      if (ts.last_track != 0 && ts.last_track != id) ++run_.id_swaps;
+      ts.last_track = id;
+      ts.tracked_last_step = true;
+    }
+    for (std::size_t j = 0; j < track_ids_.size(); ++j) {
+      TrackState& tr = track(track_ids_[j]);
+      if (!tr.seen) {
+        tr.seen = true;
+        ++run_.tracks;
+      }
+      if (track_on_target_[j]) tr.on_a_target = true;
+      else ++run_.spurious_track_steps;
+    }
+  }
+
+  std::unique_ptr<RunResult> end_run() override {
+    if (have_batch_ && !batch_used_) ++run_.unscored_truth_steps;
+    have_batch_ = false;
+    for (const TrackState& tr : track_state_)
+      if (tr.seen && !tr.on_a_target) ++run_.tracks_never_on_a_target;
+    return std::make_unique<QualityRunResult>(run_);
+  }
+
+  void merge(RunResult& result) override {
+    const auto& r = static_cast<const QualityRunResult&>(result);
+    ++runs_;
+    QualityRunResult::fields(total_, [&](auto&... t) {
+      QualityRunResult::fields(r, [&](const auto&... x) { ((t += x), ...); });
+    });
+  }
+
+  void finish(Summary& s, const FinishContext&) override {
+    const QualityRunResult& t = total_;
+    const double runs = runs_ ? static_cast<double>(runs_) : 1.0;
+    auto ratio = [](double a, double b) { return b > 0.0 ? a / b : 0.0; };
+    s.metric("completeness", ratio(double(t.tracked_truth_steps), double(t.truth_steps)));
+    s.metric("spuriousness", ratio(double(t.spurious_track_steps), double(t.track_steps)));
+    s.metric("id_swaps_per_run", double(t.id_swaps) / runs);
+    s.metric("track_breaks_per_run", double(t.breaks) / runs);
+    s.metric("targets_per_run", double(t.targets) / runs);
+    s.metric("targets_established", ratio(double(t.targets_established), double(t.targets)));
+    if (t.targets_established) s.metric("establishment_time", t.establishment_time_sum / double(t.targets_established), "s");
+    s.metric("tracks_per_run", double(t.tracks) / runs);
+    s.metric("tracks_never_on_a_target", ratio(double(t.tracks_never_on_a_target), double(t.tracks)));
+    s.metric("scored_steps", double(t.steps));
+    s.metric("unscored_truth_steps", double(t.unscored_truth_steps));
+    s.metric("steps_without_truth", double(t.steps_without_truth));
+    if (t.non_finite) s.metric("non_finite_positions", double(t.non_finite));
+    if (t.ids_out_of_range) s.metric("ids_out_of_range", double(t.ids_out_of_range));
+    s.notes.push_back(
+        "a truth is followed at a step by the track GOSPA's optimal assignment pairs it with (closer than c = " +
+        number_text::general(gospa_.cutoff(), 6) +
+        " m); completeness: followed truth-steps / truth-steps; spuriousness: track-steps following no truth / "
+        "track-steps; an id swap: a truth followed by a track other than the last one that followed it; a break: a "
+        "followed truth not followed at its next step; establishment time: from a truth's first step to its first "
+        "followed one (the established ones)");
+    if (t.non_finite || t.ids_out_of_range)
+      s.notes.push_back("left out: " + std::to_string(t.non_finite) + " non-finite positions, " +
+                        std::to_string(t.ids_out_of_range) + " ids of 2^24 or more");
+  }
+
+ private:
+  Eigen::Vector3d position(const Eigen::Vector3d& p) const { return planar_ ? Eigen::Vector3d(p.x(), p.y(), 0.0) : p; }
+
+  TargetState& target(std::uint64_t id) {
+    if (id >= targets_.size()) {
+      memory::reserve_grown(targets_, static_cast<std::size_t>(id) + 1);
+      targets_.resize(static_cast<std::size_t>(id) + 1);
+    }
+    return targets_[static_cast<std::size_t>(id)];
+  }
+  TrackState& track(std::uint64_t id) {
+    if (id >= track_state_.size()) {
+      memory::reserve_grown(track_state_, static_cast<std::size_t>(id) + 1);
+      track_state_.resize(static_cast<std::size_t>(id) + 1);
+    }
+    return track_state_[static_cast<std::size_t>(id)];
+  }
+
+  metrics::Gospa gospa_;
+  std::uint8_t statuses_;
+  bool planar_;
+  double skip_initial_;
+  QualityRunResult run_, total_;
+  std::uint64_t runs_ = 0;
+  std::vector<TargetState> targets_;
+  std::vector<TrackState> track_state_;
+  std::vector<Eigen::Vector3d> truth_pos_, track_pos_;
+  std::vector<std::uint64_t> truth_ids_, track_ids_;
+  std::vector<char> track_on_target_;
+  bool have_batch_ = false, batch_used_ = false;
+  double batch_time_ = 0.0, first_set_ = 0.0;
+};
+
+void register_components(Registrar& r) {
+  ComponentDecl d;
+  d.type = "sink.track_quality";
+  d.kind = ComponentKind::Sink;
+  d.summary = "Track quality over time: completeness, spuriousness, identity swaps, track breaks, establishment time";
+  d.doc =
+      "Inputs: a tracker's track sets and truth, e.g. inputs: [tracker, scenario]. At each TrackSet the truths of "
+      "exactly its time are paired with the tracks of the chosen statuses by GOSPA's optimal assignment (pairs "
+      "closer than cutoff; docs/multi-target-metrics.md): a truth so paired is followed by that track at that step. "
+      "Over a run, per truth target and per track id: completeness = followed truth-steps / truth-steps; "
+      "spuriousness = track-steps following no truth / track-steps; id_swaps_per_run: times a truth is followed by "
+      "a track other than the last one that followed it (CLEAR MOT's identity switches, Bernardin and Stiefelhagen "
+      "2008); track_breaks_per_run: times a followed truth is not followed at its next step while it still exists; "
+      "establishment_time: mean time from a truth's first step to its first followed one, over the truths ever "
+      "followed (targets_established: their fraction); tracks_never_on_a_target: fraction of the track ids that "
+      "never followed a truth. Sums are pooled over runs (ratios of sums). Truth and track ids index per-run "
+      "tables: ids of 2^24 or more are left out and counted. Identical for any --threads and under MPI.";
+  d.params = {
+      ParamSpec::real("cutoff", dim::length, "a track farther than this from a truth does not follow it").req().positive(),
+  };
+  for (ParamSpec& spec : scoring::track_set_params()) d.params.push_back(std::move(spec));
+  d.accepts = ItemKind::Tracks | ItemKind::Truth;
+  d.min_inputs = 2;
+  d.max_inputs = -1;
+  d.produces = 0;
+  d.create = [](const Params& p) { return std::make_unique<TrackQualitySink>(p); };
+  r.add(std::move(d));
+}
+
+}  // namespace
+}  // namespace trackflow
+
+TRACKFLOW_PLUGIN("sink.track_quality", trackflow::register_components)
