@@ -5,6 +5,7 @@
 #include <trackflow/output_path.hpp>
 #include <trackflow/plugin.hpp>
 #include <trackflow/run_result_codec.hpp>
+#include <trackflow/tracks.hpp>
 
 #include <unistd.h>
 
@@ -27,6 +28,9 @@ namespace {
 constexpr const char* kHeader =
     "run,time,source,kind,updated,x,y,z,vx,vy,vz,sigma_x,sigma_y,sigma_z,sigma_vx,sigma_vy,sigma_vz,nis,nees,"
     "truth_x,truth_y,truth_z,truth_vx,truth_vy,truth_vz";
+
+// With an input of track sets (a tracker): each track's id and status, after the truth columns.
+constexpr const char* kTrackHeader = ",track_id,track_status";
 
 // Opt-in (full_covariance): the upper triangle of the ENU covariance, row by row; units m2,
 // m2/s and m2/s2 (the sigma_* columns are the square roots of its diagonal).
@@ -64,6 +68,9 @@ struct PendingRow {
   int port = 0;
   std::uint32_t target = 0;
   bool measurement = false;
+  bool track = false;              // a tracker's track: its id and status are written
+  std::uint64_t track_id = 0;
+  TrackStatus status = TrackStatus::Tentative;
   bool updated = false;
   bool has_nis = false;
   bool has_velocity = false;
@@ -104,8 +111,9 @@ std::unique_ptr<TempFile> make_spill_file(const std::string& dir, const std::str
 // back this much at a time), ended by an empty chunk.
 constexpr std::size_t kChunkBytes = std::size_t{1} << 20;
 
-std::string column_name(int column, const std::vector<std::string>& annotation_columns, bool full_covariance) {
+std::string column_name(int column, const std::vector<std::string>& annotation_columns, bool tracks, bool full_covariance) {
   std::string header = kHeader;
+  if (tracks) header += kTrackHeader;
   if (full_covariance) header += kCovarianceHeader;
   for (const auto& a : annotation_columns) header += "," + a;
   int c = 0;
@@ -150,9 +158,11 @@ class CsvSink final : public Component, public RunResultCodec {
     annotation_columns_.clear();
     column_of_.clear();
     truth_input_ = false;
+    tracks_input_ = false;
     for (const auto& in : inputs) {
       sources_.push_back(csv::quoted(in.node));
       truth_input_ |= (in.kinds & mask(ItemKind::Truth)) != 0;
+      tracks_input_ |= (in.kinds & mask(ItemKind::Tracks)) != 0;
       // One column per annotation that exists in the pipeline ("<adapter id>.<name>"), shared
       // by inputs that carry the same name.
       auto& columns = column_of_.emplace_back();
@@ -214,6 +224,36 @@ class CsvSink final : public Component, public RunResultCodec {
     r.annotation_count = e.annotation_count;
     for (int i = 0; i < e.annotation_count; ++i) r.annotations[i] = e.annotations[i];
     arrived(e.time);
+    flush(false);
+  }
+
+  // One row per track of the set (deleted ones once, with their last state), kind "track".
+  void on_tracks(const TrackSet& set, int port) override {
+    for (const TrackEstimate& te : set.tracks) {
+      const Estimate& e = te.estimate;
+      if (!e.initialised) continue;
+      PendingRow& r = pending_.emplace_back();
+      r.time = set.time;
+      r.port = port;
+      r.track = true;
+      r.track_id = te.id;
+      r.status = te.status;
+      r.target = e.target;
+      r.updated = e.updated;
+      r.has_nis = e.updated && e.innovation.size() > 0;
+      r.nis = e.nis;
+      r.value = e.enu;
+      r.has_velocity = true;
+      r.has_sigma = true;
+      r.sigma_missing = 0;
+      for (int i = 0; i < 6; ++i) {
+        const double v = e.enu_covariance(i, i);
+        r.sigma(i) = std::sqrt(v);
+        if (v < 0.0) r.sigma_missing |= static_cast<std::uint8_t>(1u << i);
+      }
+      r.covariance = e.enu_covariance;
+    }
+    arrived(set.time);
     flush(false);
   }
 
@@ -374,6 +414,7 @@ class CsvSink final : public Component, public RunResultCodec {
       throw ConfigError("cannot write '" + partial_.string() + "': " + std::strerror(errno) + " (check 'path' and --out)",
                         path_where_, node_);
     std::string header = kHeader;
+    if (tracks_input_) header += kTrackHeader;
     if (full_covariance_) header += kCovarianceHeader;
     for (const auto& name : annotation_columns_) header += ',' + csv::quoted(name);
     header += '\n';
@@ -449,8 +490,10 @@ class CsvSink final : public Component, public RunResultCodec {
   }
 
   // The truth sample at `t`: the one of the same target if present, else the only target
-  // sampled at that time (filters need not number tracks the way the simulator numbers targets).
-  const Truth* truth_at(double t, std::uint32_t target, bool by_target) const {
+  // sampled at that time (filters need not number tracks the way the simulator numbers targets);
+  // `strict` (a tracker's track, whose target is the origin of its initiating detections): only
+  // the same target.
+  const Truth* truth_at(double t, std::uint32_t target, bool by_target, bool strict = false) const {
     auto it = std::lower_bound(truth_.begin(), truth_.end(), t - kTimeTolerance,
                                [](const Truth& s, double time) { return s.time < time; });
     const Truth* same = nullptr;
@@ -461,7 +504,7 @@ class CsvSink final : public Component, public RunResultCodec {
       if (any && any->target != it->target) one_target = false;
       if (!any || std::abs(it->time - t) < std::abs(any->time - t)) any = &*it;
     }
-    if (same) return same;
+    if (same || strict) return same;
     return one_target ? any : nullptr;
   }
 
@@ -474,7 +517,7 @@ class CsvSink final : public Component, public RunResultCodec {
     } else {
       w.text("input" + std::to_string(r.port));  // set_inputs was not called (direct use)
     }
-    w.text(r.measurement ? "measurement" : "estimate");
+    w.text(r.measurement ? "measurement" : r.track ? "track" : "estimate");
     if (r.measurement)
       w.empty();
     else
@@ -483,7 +526,7 @@ class CsvSink final : public Component, public RunResultCodec {
     for (int i = 0; i < 6; ++i)
       w.real_if(r.has_sigma && (i < 3 || r.has_velocity) && !(r.sigma_missing & (1u << i)), r.sigma(i));
     w.real_if(!r.measurement && r.has_nis, r.nis);
-    const Truth* t = truth_at(r.time, r.target, !r.measurement);
+    const Truth* t = truth_at(r.time, r.target, !r.measurement, r.track);
     Vec6 truth = Vec6::Zero();
     if (t) truth << t->position, t->velocity;
     double nees = 0.0;
@@ -497,6 +540,15 @@ class CsvSink final : public Component, public RunResultCodec {
     }
     w.real_if(has_nees, nees);
     for (int i = 0; i < 6; ++i) w.real_if(t != nullptr, truth(i));
+    if (tracks_input_) {
+      if (r.track) {
+        w.integer(r.track_id);
+        w.text(to_string(r.status));
+      } else {
+        w.empty();
+        w.empty();
+      }
+    }
     std::fill(row_annotations_.begin(), row_annotations_.end(), std::numeric_limits<double>::quiet_NaN());
     if (!r.measurement && r.port >= 0 && static_cast<size_t>(r.port) < column_of_.size()) {
       const auto& columns = column_of_[static_cast<size_t>(r.port)];
@@ -513,7 +565,7 @@ class CsvSink final : public Component, public RunResultCodec {
     if (w.non_finite()) {
       if (non_finite_ == 0) {
         first_non_finite_ = "run " + std::to_string(run_) + ", t=" + number_text::general(r.time, 10) + " s, column " +
-                            column_name(w.first_non_finite_column(), annotation_columns_, full_covariance_);
+                            column_name(w.first_non_finite_column(), annotation_columns_, tracks_input_, full_covariance_);
       }
       non_finite_ += static_cast<std::uint64_t>(w.non_finite());
     }
@@ -530,6 +582,7 @@ class CsvSink final : public Component, public RunResultCodec {
   std::vector<std::vector<int>> column_of_;  // per input port: annotation index -> column
   std::vector<double> row_annotations_;      // scratch of one row, sized once
   bool truth_input_ = true;  // until set_inputs says otherwise, rows wait for truth
+  bool tracks_input_ = false;  // an input of track sets: the track_id and track_status columns
   // Per run.
   std::uint64_t run_ = 0;
   std::vector<Truth> truth_;  // time-sorted
@@ -562,7 +615,10 @@ void register_components(Registrar& r) {
       "[,cov_x_x,cov_x_y,...,cov_vz_vz], then one column per annotation the pipeline's adapters publish on the "
       "estimates of this sink's inputs, named <adapter id>.<name> (e.g. qs.grade_range: adapt.quality_switch's "
       "grade, 0 best, 1 normal, 2 worst; adaptive_r.sigma_x: adapt.innovation_r's adapted sigma, m), empty when the "
-      "adapter has published none yet. source is the upstream node id; kind is estimate or measurement. Truth "
+      "adapter has published none yet. source is the upstream node id; kind is estimate, measurement or track. "
+      "With an input of track sets (a tracker), two more columns follow the truth: track_id and track_status "
+      "(tentative, confirmed, coasting, deleted: a deleted track's last state, once), one row per track per set; "
+      "a track's truth is that of its target (the origin of its initiating detections) only. Truth "
       "columns and nees are filled when a truth sample lies within 1 us of the row's time, nis when the estimate "
       "was updated; missing values are empty cells, and a value that is NaN or infinite is written as nan, inf or -inf "
       "and fails the run (exit 2). The file is streamed in run order while the ensemble runs (written as <file>.partial, "
@@ -584,7 +640,7 @@ void register_components(Registrar& r) {
           .at_least(1)
           .at_most(17),
   };
-  d.accepts = ItemKind::Estimate | ItemKind::Truth | mask(ItemKind::Measurement);
+  d.accepts = ItemKind::Estimate | ItemKind::Truth | mask(ItemKind::Measurement) | mask(ItemKind::Tracks);
   d.min_inputs = 1;
   d.max_inputs = -1;
   d.produces = 0;

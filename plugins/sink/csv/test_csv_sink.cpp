@@ -610,3 +610,48 @@ TEST_CASE("a NaN in a run sent between processes still fails the run") {
   CHECK_THROWS_WITH(aggregate->finish(s, {"log", dir.string(), 1}),
                     Catch::Matchers::Contains("the first in run 4, t=0.5 s, column z"));
 }
+
+// A tracker's track sets: one row per track, kind track, with its id and status; truth by target only.
+TEST_CASE("track sets: a row per track, id, status, own target truth") {
+  const InputInfo tracker{"mtt", "tracker.multi", mask(ItemKind::Tracks)};
+  const InputInfo scenario{"scenario", "sim.scenario", mask(ItemKind::Truth)};
+  auto c = make_csv("{}", {tracker, scenario});
+  c->start_run({0, 1, nullptr});
+  Truth a = truth(1.0, Vec3(10, 20, 0), Vec3(1, 0, 0));
+  a.target = 0;
+  Truth b = truth(1.0, Vec3(500, 0, 0), Vec3(0, 1, 0));
+  b.target = 1;
+  c->on_truth(a, 1);
+  c->on_truth(b, 1);
+  std::vector<TrackEstimate> set(3);
+  Vec6 x;
+  x << 11, 20, 0, 1, 0, 0;
+  set[0].id = 4;
+  set[0].status = TrackStatus::Confirmed;
+  set[0].estimate = estimate(1.0, x, covariance());
+  set[0].estimate.target = 0;
+  set[1].id = 9;
+  set[1].status = TrackStatus::Tentative;
+  set[1].estimate = estimate(1.0, x * 2.0, covariance(), false);
+  set[1].estimate.target = kOriginUnknown;  // from clutter: no truth, even with truth at that time
+  set[2].id = 11;
+  set[2].status = TrackStatus::Deleted;
+  set[2].estimate.initialised = false;  // nothing to write
+  c->on_tracks(TrackSet{1.0, set}, 0);
+  const auto rows = finished_rows(*c, scratch("tracks"));
+  REQUIRE(rows.size() == 3);
+  const std::vector<std::string>& head = rows[0];
+  REQUIRE(head.size() == 27);
+  CHECK(head[25] == "track_id");
+  CHECK(head[26] == "track_status");
+  CHECK(rows[1][Kind] == "track");
+  CHECK(rows[1][Source] == "mtt");
+  CHECK(rows[1][25] == "4");
+  CHECK(rows[1][26] == "confirmed");
+  CHECK(num(rows[1][TX]) == 10.0);  // target 0's truth
+  CHECK(!rows[1][Nees].empty());
+  CHECK(rows[2][25] == "9");
+  CHECK(rows[2][26] == "tentative");
+  CHECK(rows[2][TX].empty());  // unknown origin: no truth is claimed
+  CHECK(rows[2][Nees].empty());
+}

@@ -64,6 +64,13 @@ struct Track final : TrackContext {
   }
 };
 
+void clear_innovation(Estimate& e) {
+  e.updated = false;
+  e.nis = 0.0;
+  e.innovation.resize(0);
+  e.innovation_covariance.resize(0, 0);
+}
+
 bool finite(const Estimate& e) {
   return std::isfinite(e.state.sum() + e.covariance.sum() + e.enu.sum() + e.enu_covariance.sum());
 }
@@ -222,12 +229,13 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
       Track& t = tracks_[i];
       ++t.looks;
       bool used = false;
+      // This scan's update, or none: a coasting track publishes no innovation of an earlier scan.
+      clear_innovation(t.published.estimate);
       if (assigned_[i] >= 0) {
         const Detection& d = s.detections[static_cast<size_t>(assigned_[i])];
         const int dim = dimension(d);
         to_measurement(s, d, m_);
         set_R(*t.estimator, d, dim);
-        t.published.estimate.updated = false;
         used = t.estimator->update(m_, dim);
         ++(used ? run_.updates : run_.updates_refused);
       }
@@ -280,6 +288,11 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
       }
       Track& t = new_track();
       t.estimator->reset();
+      // A reused slot starts clean: nothing of the track that held it before (this run's or an
+      // earlier run's, which differs with the thread count) may reach the new track's estimates.
+      t.published = TrackEstimate{};
+      t.predicted = PredictedMeasurement{};
+      t.can_predict = false;
       t.time = st.first.time;
       const int dim1 = dimension(st.first);
       set_R(*t.estimator, st.first, dim1);

@@ -172,3 +172,45 @@ TEST_CASE("run result codec, wrong part refused") {
                                "initiator: { type: init.m_of_n, max_speed: 1 m/s }, deleter: { type: delete.misses } }"),
                     Catch::Contains("init.m_of_n"));
 }
+
+// A coasting track shows no innovation of an earlier scan, and a track in a reused slot (this
+// run's or an earlier run's) starts with nothing of the slot's previous track: otherwise the
+// published sets would depend on which runs a worker thread ran before.
+TEST_CASE("coasting tracks and reused slots carry nothing stale") {
+  auto n = test::make("tracker.multi", tracker_yaml("assoc.gnn", 2));
+  SetCollector out;
+  out.attach_to(*n);
+  auto run_once = [&](std::uint64_t run) {
+    out.sets.clear();
+    test::start_run(*n, run);
+    Scenario sc;
+    for (int k = 0; k < 8; ++k) n->on_scan(sc.scan_at(k, 0, k < 6), 0);  // target 2 unseen from t = 6 s
+    n->end_run();
+    return out.sets;
+  };
+  const auto first = run_once(0);
+  // Target 2's track at t = 6 s: coasting, not updated, no innovation.
+  bool saw_coasting = false;
+  for (const TrackEstimate& t : first[6].tracks)
+    if (t.status == TrackStatus::Coasting) {
+      saw_coasting = true;
+      CHECK_FALSE(t.estimate.updated);
+      CHECK(t.estimate.innovation.size() == 0);
+    }
+  CHECK(saw_coasting);
+  // The same run again on the same node (its slots now spares from the first): the same sets.
+  const auto again = run_once(0);
+  REQUIRE(again.size() == first.size());
+  for (std::size_t k = 0; k < first.size(); ++k) {
+    REQUIRE(again[k].tracks.size() == first[k].tracks.size());
+    for (std::size_t i = 0; i < first[k].tracks.size(); ++i) {
+      const TrackEstimate &a = first[k].tracks[i], &b = again[k].tracks[i];
+      CHECK(a.id == b.id);
+      CHECK(a.status == b.status);
+      CHECK(a.estimate.updated == b.estimate.updated);
+      CHECK(a.estimate.nis == b.estimate.nis);
+      CHECK(a.estimate.enu == b.estimate.enu);
+      CHECK(a.estimate.innovation.size() == b.estimate.innovation.size());
+    }
+  }
+}
