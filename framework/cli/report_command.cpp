@@ -19,13 +19,25 @@ std::string add_track_recorder(host::PipelineConfig& cfg, const host::PluginRegi
   host::NodeConfig n;
   n.id = id;
   n.type = "sink.track";
+  const auto* recorder = reg.find("sink.track");
+  if (!recorder) return {};
   for (const auto& other : cfg.nodes) {
     const auto* t = reg.find(other.type);
-    if (!t || t->decl.produces == 0 || t->decl.kind == ComponentKind::Adapter) continue;
+    // Only what the recorder takes (truth, measurements, estimates): a tracker's track sets are
+    // not one track, and wiring them in would be refused.
+    if (!t || (t->decl.produces & recorder->decl.accepts) == 0 || t->decl.kind == ComponentKind::Adapter) continue;
     n.inputs.push_back(other.id);
     n.input_locs.push_back(other.loc);
   }
-  if (n.inputs.empty()) return {};
+  // Truth alone (a multi-target scenario feeding trackers) is no track to draw: its targets would
+  // be joined into one line.
+  bool one_track = false;
+  for (const auto& id : n.inputs)
+    for (const auto& other : cfg.nodes)
+      if (other.id == id)
+        if (const auto* t = reg.find(other.type))
+          one_track |= (t->decl.produces & (mask(ItemKind::Estimate) | mask(ItemKind::Measurement))) != 0;
+  if (n.inputs.empty() || !one_track) return {};
   n.params.kind = host::Value::Kind::Map;
   host::Value v;
   v.kind = host::Value::Kind::Scalar;

@@ -259,8 +259,12 @@ void summary_section(Page& page, const host::Outcome& out, const std::vector<hos
                      unsigned threads, std::uint64_t seed, const std::string& hidden) {
   page.html("<h2>Summary</h2>\n<p>" + std::to_string(out.runs) + (out.runs == 1 ? " run" : " runs") + ", seed " +
             std::to_string(seed) + ", " + std::to_string(threads) + (threads == 1 ? " thread" : " threads") + ", " +
-            num(out.seconds) + " s; " + std::to_string(out.measurements_processed) + " measurements processed by " +
-            std::to_string(out.filters) + (out.filters == 1 ? " filter" : " filters") + ".</p>\n");
+            num(out.seconds) + " s" +
+            // As the text summary: filters are counted when there are some (a tracker's pipeline has none).
+            (out.filters > 0 ? "; " + std::to_string(out.measurements_processed) + " measurements processed by " +
+                                   std::to_string(out.filters) + (out.filters == 1 ? " filter" : " filters")
+                             : std::string()) +
+            ".</p>\n");
   for (const auto& n : out.nodes) {
     if (n.id == hidden) continue;
     if (n.summary.metrics.empty() && n.summary.notes.empty() && n.skips == 0) continue;

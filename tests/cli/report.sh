@@ -97,4 +97,15 @@ for type in sim.trajectory sim.radar filter.ekf; do
 done
 echo "ok: describe aligns long names, nested fields and choice lists"
 checks=$((checks + 1))
+# --- the report of a multi-target pipeline: trackers are no single track to draw -----------------
+# (the track recorder once took the tracker's track sets as input and the report was refused)
+"$TF" report "$ROOT/pipelines/crossing_targets.yaml" --runs 4 --threads 2 --no-progress --out "$TMP/mtt" > "$TMP/mtt.log" 2>&1
+rc=$?
+[ "$rc" -le 1 ] || fail "report of crossing_targets: exit $rc: $(cat "$TMP/mtt.log")"   # 4 runs may fail an expect
+[ -s "$TMP/mtt/report.html" ] || fail "report of crossing_targets wrote no report.html: $(cat "$TMP/mtt.log")"
+grep -q 'gospa_gnn' "$TMP/mtt/report.html" || fail "the multi-target report lacks sink.gospa's summary"
+grep -q 'measurements processed by 0 filters' "$TMP/mtt/report.html" && fail "the multi-target report counts 0 filters"
+[ -s "$TMP/mtt/gospa_gnn.gospa.csv" ] || fail "no GOSPA series CSV next to the report"
+checks=$((checks + 1)); echo "ok: report of a multi-target pipeline (GOSPA summaries and series, no single-track plot)"
+
 finish
