@@ -205,7 +205,16 @@ class CsvSink final : public Component, public RunResultCodec {
   void on_estimate(const Estimate& e, int port) override {
     if (!e.initialised) return;
     PendingRow& r = pending_.emplace_back();
-    r.time = e.time;
+    fill_from(r, e, e.time, port);
+    r.annotation_count = e.annotation_count;
+    for (int i = 0; i < e.annotation_count; ++i) r.annotations[i] = e.annotations[i];
+    arrived(e.time);
+    flush(false);
+  }
+
+  // An estimate's (or a track's) cells: ENU state, sigmas, NIS, its target for the truth.
+  static void fill_from(PendingRow& r, const Estimate& e, double time, int port) {
+    r.time = time;
     r.port = port;
     r.target = e.target;
     r.updated = e.updated;
@@ -221,10 +230,6 @@ class CsvSink final : public Component, public RunResultCodec {
       if (v < 0.0) r.sigma_missing |= static_cast<std::uint8_t>(1u << i);  // NaN stays a value: "nan"
     }
     r.covariance = e.enu_covariance;
-    r.annotation_count = e.annotation_count;
-    for (int i = 0; i < e.annotation_count; ++i) r.annotations[i] = e.annotations[i];
-    arrived(e.time);
-    flush(false);
   }
 
   // One row per track of the set (deleted ones once, with their last state), kind "track".
@@ -233,25 +238,10 @@ class CsvSink final : public Component, public RunResultCodec {
       const Estimate& e = te.estimate;
       if (!e.initialised) continue;
       PendingRow& r = pending_.emplace_back();
-      r.time = set.time;
-      r.port = port;
+      fill_from(r, e, set.time, port);
       r.track = true;
       r.track_id = te.id;
       r.status = te.status;
-      r.target = e.target;
-      r.updated = e.updated;
-      r.has_nis = e.updated && e.innovation.size() > 0;
-      r.nis = e.nis;
-      r.value = e.enu;
-      r.has_velocity = true;
-      r.has_sigma = true;
-      r.sigma_missing = 0;
-      for (int i = 0; i < 6; ++i) {
-        const double v = e.enu_covariance(i, i);
-        r.sigma(i) = std::sqrt(v);
-        if (v < 0.0) r.sigma_missing |= static_cast<std::uint8_t>(1u << i);
-      }
-      r.covariance = e.enu_covariance;
     }
     arrived(set.time);
     flush(false);
