@@ -16,6 +16,7 @@
 #include <fstream>
 #include <map>
 #include <set>
+#include <utility>
 
 namespace trackflow::report {
 namespace {
@@ -472,6 +473,28 @@ void track_section(Page& page, const host::Graph& g, const host::Outcome& out, c
 }
 
 // Series of per-interval RMSE (sink.interval_rmse): the filter against the measurements.
+// sink.gospa's series: GOSPA of every scored tracker against time, then each one's parts (alpha = 2).
+void gospa_section(Page& page, const host::Outcome& out) {
+  std::vector<Line> totals;
+  std::vector<std::pair<std::string, const Series*>> with_parts;
+  for (const auto& n : out.nodes)
+    for (const auto& s : n.summary.series) {
+      if (s.name != "gospa" || s.column("gospa") < 0) continue;
+      totals.push_back(column_line(s, "gospa", n.id));
+      if (s.column("gospa_localisation") >= 0) with_parts.emplace_back(n.id, &s);
+    }
+  if (totals.empty()) return;
+  page.html("<h2>GOSPA against time</h2>\n<p class=\"note\">Mean over the runs, per track set, of the GOSPA distance "
+            "between the truths and the tracks (docs/multi-target-metrics.md); below, the three parts of its p-th "
+            "power: localisation of the tracks that follow a target, missed targets, false tracks.</p>\n");
+  page.chart(line_chart("GOSPA against time", "time [s]", "GOSPA [m]", totals));
+  for (const auto& [id, s] : with_parts) {
+    std::vector<Line> parts = {column_line(*s, "gospa_localisation", "localisation"),
+                               column_line(*s, "gospa_missed", "missed"), column_line(*s, "gospa_false", "false")};
+    page.chart(line_chart("GOSPA parts (p-th power) against time - " + id, "time [s]", "part of GOSPA^p", parts));
+  }
+}
+
 void interval_section(Page& page, const host::Graph& g, const host::Outcome& out) {
   bool header = false;
   for (size_t i = 0; i < out.nodes.size() && i < g.nodes.size(); ++i)
@@ -512,6 +535,7 @@ std::string render_run_report(const RunReport& r) {
   const auto scored = scored_series(g, out);
   error_section(page, scored);
   consistency_section(page, scored);
+  gospa_section(page, out);
   if (!r.track_node.empty()) track_section(page, g, out, r.track_node, r.track_run);
   annotation_section(page, scored);
   interval_section(page, g, out);

@@ -106,6 +106,8 @@ rc=$?
 grep -q 'gospa_gnn' "$TMP/mtt/report.html" || fail "the multi-target report lacks sink.gospa's summary"
 grep -q 'measurements processed by 0 filters' "$TMP/mtt/report.html" && fail "the multi-target report counts 0 filters"
 [ -s "$TMP/mtt/gospa_gnn.gospa.csv" ] || fail "no GOSPA series CSV next to the report"
-checks=$((checks + 1)); echo "ok: report of a multi-target pipeline (GOSPA summaries and series, no single-track plot)"
+grep -q 'GOSPA against time' "$TMP/mtt/report.html" || fail "the multi-target report has no GOSPA chart"
+grep -q 'GOSPA parts (p-th power) against time - gospa_nn' "$TMP/mtt/report.html" || fail "no GOSPA parts chart per scoring node"
+checks=$((checks + 1)); echo "ok: report of a multi-target pipeline (GOSPA summaries, charts and series, no single-track plot)"
 
 finish
