@@ -20,7 +20,7 @@ TEST_PLUGINS="$PLUGINS/../test-plugins"
 cd "$TMP"
 
 # The summary without what differs between any two runs: wall time, rates, threads, MPI note, paths.
-summary() { grep -vE '^  [0-9]+ runs?, |measurements processed:|source items:|^\(runs shared by|^wrote ' "$1"; }
+summary() { grep -vE '^  [0-9]+ runs?, |measurements processed:|source items:|^\(runs shared by|^ *wrote ' "$1"; }
 same_dir() {  # every file of $1 byte-identical in $2, and nothing else there
   local a=$1 b=$2 n=0 f
   shopt -s nullglob
