@@ -392,6 +392,8 @@ GraphInstance instantiate_checked(const Graph& g, const PluginRegistry& registry
       inst.roots.push_back(static_cast<int>(i));
     }
   }
+  for (int i : g.order)
+    if (g.nodes[i].type->decl.groups_by_time) inst.time_grouping.push_back(i);
   for (size_t i = 0; i < N; ++i)
     inst.components[i]->out.connect(inst.links[i].data(), static_cast<int>(inst.links[i].size()));
   // What adapters tune is put back to this at the start of every run (engine).

@@ -14,20 +14,53 @@
 namespace trackflow::host {
 namespace {
 
+// Tells the groups_by_time nodes when an instant is over: before the first emission of a later
+// time, and after the run's last item. Without such nodes it does nothing.
+class InstantCloser {
+ public:
+  explicit InstantCloser(GraphInstance& inst) : inst_(inst) {}
+  void before(double t) {
+    if (inst_.time_grouping.empty()) return;
+    if (open_ && t > time_) close();
+    open_ = true;
+    time_ = t;
+  }
+  void finish() {
+    if (open_) close();
+    open_ = false;
+  }
+
+ private:
+  void close() {
+    for (int i : inst_.time_grouping) {
+      Component* c = inst_.components[i].get();
+      detail::executing = c;
+      c->on_time_complete(time_);
+    }
+  }
+  GraphInstance& inst_;
+  bool open_ = false;
+  double time_ = 0.0;
+};
+
 // One run on one instance: the generator with the earliest next item goes first; ties go to
 // the generator declared first, so the order never depends on timing. A generator whose next
 // time is not a number is exhausted, as one at +infinity.
 std::uint64_t drive(GraphInstance& inst) {
   std::vector<Generator*> gens;
   for (int r : inst.roots) gens.push_back(static_cast<Generator*>(inst.components[r].get()));
+  InstantCloser instants(inst);
   std::uint64_t items = 0;
   if (gens.size() == 1) {
     Generator* g = gens[0];
     detail::executing = g;
-    while (std::isfinite(g->next_time())) {
+    for (double t = g->next_time(); std::isfinite(t); t = g->next_time()) {
+      instants.before(t);
+      detail::executing = g;
       g->emit_next();
       ++items;
     }
+    instants.finish();
     return items;
   }
   if (gens.size() <= 8) {
@@ -42,11 +75,14 @@ std::uint64_t drive(GraphInstance& inst) {
           best = g;
         }
       }
-      if (!best) return items;
+      if (!best) break;
+      instants.before(t);
       detail::executing = best;
       best->emit_next();
       ++items;
     }
+    instants.finish();
+    return items;
   }
   // Many sources: a heap on (time, declaration order) keeps a step logarithmic. Only the
   // generator that emitted changes its next time (generators have no inputs).
@@ -58,14 +94,16 @@ std::uint64_t drive(GraphInstance& inst) {
     if (t < std::numeric_limits<double>::infinity()) heap.emplace(t, i);
   }
   while (!heap.empty()) {
-    const std::size_t i = heap.top().second;
+    const auto [t0, i] = heap.top();
     heap.pop();
+    instants.before(t0);
     detail::executing = gens[i];
     gens[i]->emit_next();
     ++items;
     const double t = gens[i]->next_time();
     if (t < std::numeric_limits<double>::infinity()) heap.emplace(t, i);
   }
+  instants.finish();
   return items;
 }
 

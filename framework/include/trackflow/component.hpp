@@ -162,6 +162,12 @@ class BOOST_SYMBOL_VISIBLE Component {
   virtual void on_estimate(const Estimate&, int port);
   virtual void on_scan(const Scan&, int port);
   virtual void on_tracks(const TrackSet&, int port);
+  // Called on a node whose type sets ComponentDecl::groups_by_time, once everything of time
+  // `time` has been delivered: every source has emitted all it has up to `time` and its next
+  // item, if any, is later (also after a run's last item). A node that gathers what arrives at one
+  // instant (a scan radar making one look of every target) emits it here. Nodes are called
+  // upstream first, so what one emits here reaches a downstream one before that one's own call.
+  virtual void on_time_complete(double /*time*/) {}
   // Called after the last item of a run; the result (may be null) goes to merge() of the
   // aggregating instance, in run order, so reductions are identical whatever the thread count.
   virtual std::unique_ptr<RunResult> end_run() { return nullptr; }

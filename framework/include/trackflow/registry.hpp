@@ -35,6 +35,9 @@ struct ComponentDecl {
   // A source whose items come in non-decreasing time within a run (out-of-order ones refused or
   // skipped); its consumers learn it through InputInfo::time_ordered.
   bool time_ordered = false;
+  // Its instances gather the items of one instant and emit them from Component::on_time_complete
+  // (a scan radar); the engine calls that only on nodes that set this.
+  bool groups_by_time = false;
   std::function<std::unique_ptr<Component>(const Params&)> create;
   // A filter whose state estimator runs per track (estimator.hpp): the same parameters make the
   // estimator alone, which a tracker (or filter.imm, as a mode) clones for each track it starts.

@@ -4,6 +4,9 @@
 #include <trackflow/rng.hpp>
 #include <trackflow/run_result_codec.hpp>
 
+#include "simulation/detection_order.hpp"
+#include "simulation/poisson.hpp"
+
 #include <Eigen/Cholesky>
 
 #include <algorithm>
@@ -17,41 +20,13 @@
 namespace trackflow {
 namespace {
 
+using simulation::poisson;
+
 constexpr double kInf = std::numeric_limits<double>::infinity();
 // Step times are start + k T; a scripted birth or death this close to a step counts as at it.
 constexpr double kTimeTolerance = 1e-9;  // s
 // Planar without a z range: clutter z is spread over ± this many sigma_z around z = 0.
 constexpr double kPlanarZSigmas = 3.0;
-
-// Poisson(mean) from uniforms of `rng`: multiplication of uniforms (Knuth) below 30, above it the
-// transformed rejection with squeeze of Hörmann 1993 (PTRS), so the draw is exact at any mean
-// and its sequence fixed by this code alone.
-std::uint64_t poisson(Rng& rng, double mean) {
-  if (!(mean > 0.0)) return 0;
-  if (mean < 30.0) {
-    const double limit = std::exp(-mean);
-    std::uint64_t k = 0;
-    double prod = rng.uniform();
-    while (prod > limit) {
-      ++k;
-      prod *= rng.uniform();
-    }
-    return k;
-  }
-  const double slam = std::sqrt(mean), loglam = std::log(mean);
-  const double b = 0.931 + 2.53 * slam, a = -0.059 + 0.02483 * b;
-  const double invalpha = 1.1239 + 1.1328 / (b - 3.4), vr = 0.9277 - 3.6224 / (b - 2.0);
-  for (;;) {
-    const double u = rng.uniform() - 0.5, v = rng.uniform();
-    const double us = 0.5 - std::fabs(u);
-    const double k = std::floor((2.0 * a / us + b) * u + mean + 0.43);
-    if (us >= 0.07 && v <= vr) return static_cast<std::uint64_t>(k);
-    if (k < 0.0 || (us < 0.013 && v > us)) continue;
-    int sign = 0;
-    if (std::log(v) + std::log(invalpha) - std::log(a / (us * us) + b) <= -mean + k * loglam - ::lgamma_r(k + 1.0, &sign))
-      return static_cast<std::uint64_t>(k);
-  }
-}
 
 struct Box {
   Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();
@@ -371,11 +346,7 @@ class ScenarioSource final : public Generator, public FieldListCodec<ScenarioRun
       ++run_.clutter;
     }
     // Sorted by x, then y, then z, so the order gives nothing of the origin away.
-    std::sort(detections_.begin(), detections_.end(), [](const Detection& a, const Detection& b) {
-      if (a.value[0] != b.value[0]) return a.value[0] < b.value[0];
-      if (a.value[1] != b.value[1]) return a.value[1] < b.value[1];
-      return a.value[2] < b.value[2];
-    });
+    simulation::sort_detections(detections_);
     scan_.time = t;
     scan_.detections = std::span<const Detection>(detections_.data(), detections_.size());
     out.emit(scan_);

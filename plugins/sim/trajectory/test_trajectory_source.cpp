@@ -524,3 +524,37 @@ TEST_CASE("process noise parameters are checked") {
   CHECK_THAT(config_error(head + "process_noise_q_enu: [1, 1, 1]\nprocess_noise_q_jerk_enu: [1, 1, 1]\n"),
              Catch::Matchers::Contains("not both"));
 }
+
+// A jettisoned body starts on its parent's sample grid at the separation, with the parent's state
+// plus the separation velocity, then falls freely (closed form) until it is back on the ground.
+TEST_CASE("a jettisoned body falls from its parent's state at separation") {
+  const std::string flight = R"(
+    rate: 10 Hz
+    initial_position: [0 m, 0 m, 1000 m]
+    initial_velocity: [100 m/s, 0 m/s, 50 m/s]
+    segments:
+      - {type: constant_velocity, duration: 100 s}
+)";
+  const auto parent = fly(flight);
+  const auto stage = fly(flight + "    target: 1\n    jettison_time: 10.05 s\n    jettison_velocity: [0, -2 m/s, 0]\n");
+  REQUIRE(!stage.empty());
+  CHECK(stage.front().time == Approx(10.1));  // first sample of the grid at or after the separation
+  CHECK(stage.front().target == 1);
+  // Both on one grid: the stage's k-th sample is the parent's (101 + k)-th.
+  REQUIRE(parent[101].time == stage.front().time);
+  const Vec3 p0(100 * 10.05, 0.0, 1000 + 50 * 10.05), v0(100, -2, 50);
+  for (const Truth& t : stage) {
+    const double tau = t.time - 10.05;
+    const Vec3 expected = p0 + v0 * tau + 0.5 * Vec3(0, 0, -9.80665) * tau * tau;
+    CHECK((t.position - expected).norm() < 1e-6);
+    CHECK(t.acceleration.z() == Approx(-9.80665));
+  }
+  // Impact at the start's height (1000 m): z0 + vz tau - g tau^2/2 = 1000.
+  const double h = p0.z() - 1000.0, g = 9.80665, tau = (50.0 + std::sqrt(50.0 * 50.0 + 2 * g * h)) / g;
+  CHECK(stage.back().time <= 10.05 + tau + 1e-9);
+  CHECK(stage.back().time > 10.05 + tau - 0.1);
+  CHECK(stage.back().position.z() >= 1000.0 - 1e-6);
+  // Refusals: outside the flight, a curved earth, the fall's parameters without a jettison.
+  CHECK_THAT(config_error(flight + "    jettison_time: 200 s\n"), Catch::Contains("within the flight"));
+  CHECK_THAT(config_error(flight + "    gravity: 9 m/s2\n"), Catch::Contains("give jettison_time"));
+}

@@ -1,6 +1,7 @@
 // Purpose: sim.trajectory — a truth generator that flies CV / CA / turn / velocity-change segments or a launch profile exactly, optionally with white-noise acceleration or jerk.
 #include "flight_plan.hpp"
 #include "geodetic_launch.hpp"
+#include "jettison.hpp"
 #include "launch_profile.hpp"
 #include "process_noise.hpp"
 
@@ -25,8 +26,8 @@ std::vector<MotionPiece> build_pieces(const Params& params) {
   if (params.given("pad_site") && !(wgs84 && params.choice<sim::Profile>("profile") != sim::Profile::None))
     throw params.error("pad_site", "applies to a launch profile on 'earth: wgs84' only (flat and spherical earths take "
                                    "pad_position)");
-  if (params.choice<sim::Profile>("profile") == sim::Profile::None) return sim::build_flight_plan(params);
-  return wgs84 ? sim::build_geodetic_launch_plan(params) : sim::build_launch_plan(params);
+  if (params.choice<sim::Profile>("profile") == sim::Profile::None) return sim::apply_jettison(params, sim::build_flight_plan(params));
+  return sim::apply_jettison(params, wgs84 ? sim::build_geodetic_launch_plan(params) : sim::build_launch_plan(params));
 }
 
 class TrajectorySource final : public Generator {
@@ -41,10 +42,14 @@ class TrajectorySource final : public Generator {
     const double span = (pieces_.back().end - start_) * rate_;
     if (span > 1e10) throw params.error("rate", "gives more than 1e10 samples over the trajectory; lower it");
     sample_count_ = static_cast<long long>(std::floor(span + kTimeTolerance * rate_)) + 1;
+    // A jettisoned body exists from the separation on, sampled on the same grid start_time + k/rate
+    // as its parent, so a radar sees both in one look.
+    first_sample_ = static_cast<long long>(std::ceil((pieces_.front().start - start_) * rate_ - kTimeTolerance * rate_));
+    if (first_sample_ < 0) first_sample_ = 0;
   }
 
   void start_run(const RunContext& ctx) override {
-    next_sample_ = 0;
+    next_sample_ = first_sample_;
     piece_ = 0;
     if (noise_.enabled()) noise_.reset(ctx.seed);
     if (jerk_.enabled()) jerk_.reset(ctx.seed);
@@ -55,7 +60,7 @@ class TrajectorySource final : public Generator {
   }
 
   void emit_next() override {
-    const bool first = next_sample_ == 0;
+    const bool first = next_sample_ == first_sample_;
     const double t = sample_time(next_sample_++);
     // Samples only move forward, so the current piece only moves forward too.
     while (piece_ + 1 < pieces_.size() && pieces_[piece_ + 1].start <= t + kTimeTolerance) ++piece_;
@@ -88,6 +93,7 @@ class TrajectorySource final : public Generator {
   double rate_, start_;
   long long sample_count_ = 0;
   long long next_sample_ = 0;
+  long long first_sample_ = 0;
   size_t piece_ = 0;
   sim::WhiteAccelerationNoise noise_;
   sim::WhiteJerkNoise jerk_;
@@ -173,7 +179,14 @@ void register_components(Registrar& r) {
           "acceleration. A constant-acceleration filter.ekf / filter.ukf with q_jerk equal to it is the matched model. "
           "Three standard normals per axis per sample. The deviation grows without bound (velocity sd sqrt(q t³/3), "
           "position sd sqrt(q t⁵/20) after t seconds: 46 m/s and 7.2 km after 400 s at q = 1e-4 m2/s5). The two models "
-          "are exclusive.";
+          "are exclusive.\n"
+          "Jettison (off by default): jettison_time makes this node a body that separates from the flight above at "
+          "that time (a spent stage): it exists from its first sample at or after jettison_time (on the same grid "
+          "start_time + k/rate, so a radar sees it in the parent's looks) and falls freely from the flight's position "
+          "and velocity there plus jettison_velocity, p(t) = p0 + v0 τ + a τ²/2 with a = [0, 0, -gravity], τ = t - "
+          "jettison_time (flat earth, no drag), until the end of the flight or until it is back at the pad's height, "
+          "whichever is first. A second sim.trajectory node with the same flight and no jettison_time is the body that "
+          "flies on (give the two different target ids).";
   d.params = {
       ParamSpec::real("rate", dim::frequency, "sample rate of the truth").def("10 Hz").positive(),
       ParamSpec::real("start_time", dim::time, "time of the first sample and of the start of the first segment").def("0 s"),
@@ -196,6 +209,10 @@ void register_components(Registrar& r) {
       sim::sites_param(),
       sim::frame_origin_param(),
       ParamSpec::real("profile_duration", dim::time, "profile: fly only the first part of it (default: the whole table)").positive(),
+      ParamSpec::real("jettison_time", dim::time, "a body jettisoned from this flight at this time: free fall from then on"),
+      ParamSpec::real_list("jettison_velocity", dim::velocity, "jettison: ENU separation velocity added to the flight's", 3)
+          .def("[0, 0, 0]"),
+      ParamSpec::real("gravity", dim::acceleration, "jettison: gravitational acceleration of the free fall").def("9.80665 m/s2").at_least(0),
       ParamSpec::real("process_noise_q", dim::accel_psd,
                       "spectral density of white acceleration added to the truth, every ENU axis (0: off)")
           .def("0 m2/s3")

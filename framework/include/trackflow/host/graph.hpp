@@ -37,6 +37,7 @@ struct GraphInstance {
   std::vector<std::shared_ptr<Component>> components;  // by node index
   std::vector<std::vector<Link>> links;                 // by node index
   std::vector<int> roots;                               // generator nodes
+  std::vector<int> time_grouping;                       // nodes with groups_by_time, upstream first
 };
 GraphInstance instantiate(const Graph& g, const PluginRegistry& registry);
 
