@@ -259,6 +259,26 @@ void check_frames(const Graph& g, const GraphInstance& inst, const PluginRegistr
   }
 }
 
+// What each wire carries once the upstream instance says which of its type's kinds it emits (a
+// source.csv of detections emits scans only): a wire left with nothing is refused before anything runs.
+std::vector<std::vector<ItemMask>> narrowed_input_kinds(const Graph& g, const GraphInstance& inst) {
+  std::vector<std::vector<ItemMask>> out(g.nodes.size());
+  for (size_t i = 0; i < g.nodes.size(); ++i) {
+    const GraphNode& n = g.nodes[i];
+    for (size_t k = 0; k < n.inputs.size(); ++k) {
+      const GraphNode& up = g.nodes[n.inputs[k]];
+      const ItemMask produced = up.type->decl.produces & inst.components[n.inputs[k]]->produced_kinds();
+      const ItemMask m = n.input_kinds[k] & produced;
+      if (m == 0)
+        throw ConfigError("input '" + up.config.id + "' (" + up.config.type + " as configured) produces " + kinds(produced) +
+                              ", but " + n.config.type + " accepts " + kinds(n.type->decl.accepts),
+                          n.config.input_locs[k], n.config.id);
+      out[i].push_back(m);
+    }
+  }
+  return out;
+}
+
 std::string qualified(const std::string& adapter, const std::vector<std::string>& names, size_t i) {
   return adapter + "." + names[i];
 }
@@ -311,6 +331,7 @@ GraphInstance instantiate_checked(const Graph& g, const PluginRegistry& registry
     }
   }
   check_frames(g, inst, registry);
+  const std::vector<std::vector<ItemMask>> input_kinds = narrowed_input_kinds(g, inst);
 
   // Adapters first: what they need is checked against the filter, and the filter's annotation
   // names are known before its consumers learn their inputs.
@@ -364,7 +385,7 @@ GraphInstance instantiate_checked(const Graph& g, const PluginRegistry& registry
     std::vector<InputInfo> infos;
     for (size_t k = 0; k < n.inputs.size(); ++k) {
       const int up = n.inputs[k];
-      InputInfo info{g.nodes[up].config.id, g.nodes[up].config.type, n.input_kinds[k], annotations[up]};
+      InputInfo info{g.nodes[up].config.id, g.nodes[up].config.type, input_kinds[i][k], annotations[up]};
       if (const auto* f = dynamic_cast<const Filter*>(inst.components[up].get())) {
         info.state = f->state_layout();
         if (const TransitionModel* t = f->transition_model()) info.transition = *t;
@@ -384,7 +405,7 @@ GraphInstance instantiate_checked(const Graph& g, const PluginRegistry& registry
                           ") threw an exception that is not a std::exception in set_inputs (a bug in that plugin)");
     }
     for (size_t k = 0; k < n.inputs.size(); ++k)
-      inst.links[n.inputs[k]].push_back({inst.components[i].get(), static_cast<int>(k), n.input_kinds[k]});
+      inst.links[n.inputs[k]].push_back({inst.components[i].get(), static_cast<int>(k), input_kinds[i][k]});
     if (n.inputs.empty() && n.type->decl.kind != ComponentKind::Adapter) {
       if (!dynamic_cast<Generator*>(inst.components[i].get()))
         throw ConfigError(n.config.type + " needs an input ('input: <node id>'); only sources can stand alone",

@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Purpose: the engine closes an instant once every source has emitted all of its time: two truth sources at 10 Hz and 4 Hz into one sim.scan_radar give one look per distinct time (121 in 10 s), each with every target of that time, for any --threads and in every run.
+# Purpose: the engine closes an instant once every source has emitted all of its time: two truth sources at 10 Hz and 4 Hz into one sim.scan_radar give one look per distinct time (121 in 10 s), each with every target of that time, for any --threads and in every run; a source.csv of detections is a scan source: a tracker takes it, a filter is refused at its input line.
 set -u
 TF=$1
 source "$(dirname "$0")/lib.sh"
@@ -36,4 +36,34 @@ done
 # A single source emitting its targets one item at a time (sim.trajectory) still closes each instant.
 sed -i 's/inputs: \[fast, slow\]/inputs: [fast]/' "$TMP/instants.yaml"
 expect_run "a single source: one look per sample" 0 "looks +101$" -- "$TF" run "$TMP/instants.yaml"
+
+# A recorded detection log (content: detections) feeds a tracker; wired to a filter it is refused
+# before anything runs, naming the filter's input line.
+{
+  echo "time,x,y,z"
+  for k in 0 1 2 3 4 5 6 7 8 9; do echo "$k,$((10 * k)),5,0"; echo "$k,$((10 * k)),-300,0"; done
+} > "$TMP/plots.csv"
+cat > "$TMP/log.yaml" <<YAML
+pipeline: { name: log, runs: 1 }
+nodes:
+  - id: log
+    type: source.csv
+    params: { path: plots.csv, content: detections, frame: cartesian, detection_probability: 0.9, clutter_density: 1e-9 }
+  - id: mtt
+    type: tracker.multi
+    input: log
+    params:
+      estimator: { type: filter.kalman, q: 0.1 m2/s3 }
+      associator: { type: assoc.gnn }
+      initiator: { type: init.m_of_n, m: 2, n: 3, max_speed: 20 m/s }
+      deleter: { type: delete.misses }
+YAML
+expect_run "a detection log through tracker.multi: two tracks" 0 "tracks_confirmed_per_run +2$" -- "$TF" run "$TMP/log.yaml"
+expect_run "a detection log counts its scans" 0 "scans +10$" -- "$TF" run "$TMP/log.yaml"
+head -5 "$TMP/log.yaml" > "$TMP/filter.yaml"
+printf '  - { id: mtt, type: filter.kalman,\n      input: log }\n' >> "$TMP/filter.yaml"
+line=$(grep -n "input: log" "$TMP/filter.yaml" | cut -d: -f1)
+expect_run "a detection log into a filter is refused at its input" 2 \
+  "filter.yaml:$line:[0-9]+: node 'mtt': input 'log' \\(source.csv as configured\\) produces scan, but filter.kalman accepts measurement" \
+  -- "$TF" validate "$TMP/filter.yaml"
 finish

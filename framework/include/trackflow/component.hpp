@@ -155,6 +155,9 @@ class BOOST_SYMBOL_VISIBLE Component {
   // The measurement frames this instance emits, when its parameters narrow what its type
   // declares (a recorded log of Cartesian positions); checked against its consumers.
   virtual FrameMask produced_frames() const { return kAnyFrame; }
+  // The item kinds this instance emits, when its parameters narrow what its type declares (a log
+  // of detections emits scans, one of measurements measurements); its wires are checked against it.
+  virtual ItemMask produced_kinds() const { return static_cast<ItemMask>(~ItemMask{0}); }
   virtual void start_run(const RunContext&) {}
   // Items arriving on input `port` (the position of the source in the node's `inputs:`).
   virtual void on_truth(const Truth&, int port);

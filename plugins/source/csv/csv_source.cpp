@@ -1,4 +1,4 @@
-// Purpose: source.csv — replays a recorded radar log (CSV with a header row) as Measurements, checking every row.
+// Purpose: source.csv — replays a recorded radar log (CSV with a header row) as Measurements, or as Scans of detections grouped by a scan column or by time, checking every row.
 #include "csv_text.hpp"
 
 #include <fcntl.h>
@@ -9,8 +9,10 @@
 #include <trackflow/geometry.hpp>
 #include <trackflow/common_params.hpp>
 #include <trackflow/plugin.hpp>
+#include <trackflow/scan.hpp>
 
 #include <algorithm>
+#include <array>
 #include <cctype>
 #include <cerrno>
 #include <cmath>
@@ -45,6 +47,7 @@ enum class TimeUnit { Second, Millisecond };
 enum class LengthUnit { Metre, Kilometre };
 enum class AngleUnit { Degree, Radian, Milliradian };
 enum class OnBadRow { Error, Skip };
+enum class Content { Measurements, Detections };
 
 double angle_scale(AngleUnit unit) {
   if (unit == AngleUnit::Degree) return std::numbers::pi / 180.0;
@@ -135,7 +138,7 @@ bool plausible_header(const std::vector<std::string>& names) {
 }
 
 // The columns a source may read, in the order their positions are kept.
-constexpr int kColumns = 9;
+constexpr int kColumns = 11;
 
 // What checking the whole file found, shared read-only by every instance (one per worker
 // thread, plus the one that aggregates) built from the same file and parameters. No rows are
@@ -156,6 +159,7 @@ struct CheckedLog {
   std::vector<std::string> skipped;  // the first kMaxSkipMessages messages
   std::size_t skipped_count = 0;
   std::size_t rows_read = 0;
+  std::size_t scans = 0, largest_scan = 0;  // content: detections
 };
 constexpr std::size_t kMaxSkipMessages = 1000;
 
@@ -224,13 +228,13 @@ class CsvSource final : public Generator {
       cache.logs[key] = log_;
     }
     cache.latest = log_;
-    Column* columns[kColumns] = {&time_, &value_[0], &value_[1], &value_[2], &range_rate_, &snr_, &mode_, &valid_, &sensor_};
-    for (int i = 0; i < kColumns; ++i) columns[i]->index = log_->column_index[i];
+    for (int i = 0; i < kColumns; ++i) columns()[i]->index = log_->column_index[i];
     field_count_ = log_->field_count;
     header_number_ = log_->header_line;
     // Sized for the longest data line: replaying never allocates.
     stream_ = csv::LineStream(log_->buffer);
     fields_.reserve(field_count_ + 1);
+    detections_.reserve(log_->largest_scan);
   }
 
   void start_run(const RunContext& ctx) override {
@@ -254,22 +258,60 @@ class CsvSource final : public Generator {
   }
 
   FrameMask produced_frames() const override { return mask(frame_); }
+  ItemMask produced_kinds() const override {
+    return mask(content_ == Content::Detections ? ItemKind::Scan : ItemKind::Measurement);
+  }
 
   double next_time() const override { return has_current_ ? current_.time : std::numeric_limits<double>::infinity(); }
 
   void emit_next() override {
     if (!has_current_) return;
-    out.emit(current_);
-    advance();
+    if (content_ == Content::Measurements) {
+      out.emit(current_);
+      advance();
+      return;
+    }
+    // One scan: this row and every following one of the same scan (a look without detections is
+    // a row with no values). Its time and sensor are its first row's.
+    detections_.clear();
+    static_cast<SensorFrame&>(scan_.sensor) = current_;
+    scan_.time = current_.time;
+    const double time = current_.time;
+    const std::uint32_t key = row_scan_;
+    do {
+      if (!row_empty_) detections_.push_back(static_cast<const Detection&>(current_));
+      advance();
+    } while (has_current_ && same_scan(time, key, current_.time, row_scan_));
+    scan_.detections = std::span<const Detection>(detections_.data(), detections_.size());
+    out.emit(scan_);
   }
 
   void finish(Summary& s, const FinishContext&) override {
     s.metric("rows", static_cast<double>(log_->rows_read));
     s.metric("skipped_rows", static_cast<double>(log_->skipped_count));
+    if (content_ == Content::Detections) s.metric("scans", static_cast<double>(log_->scans));
   }
 
  private:
+  std::array<Column*, kColumns> columns() {
+    return {&time_, &value_[0], &value_[1], &value_[2], &range_rate_, &snr_, &mode_, &valid_, &sensor_, &scan_id_, &origin_};
+  }
+
+  // Rows of one scan: the same scan id with a scan column, else the same time.
+  bool same_scan(double time, std::uint32_t key, double t, std::uint32_t k) const {
+    return scan_id_.read() ? k == key : t == time;
+  }
+
   void configure(const Params& p) {
+    content_ = p.choice<Content>("content");
+    const bool detections = content_ == Content::Detections;
+    for (const char* name : {"scan_column", "detection_probability", "clutter_density"})
+      if (!detections && p.given(name)) throw p.error(name, "applies only to content: detections (rows grouped into scans)");
+    if (detections && p.given("valid_column"))
+      throw p.error("valid_column", "applies to content: measurements; in a log of detections every row is a detection, and a "
+                                    "look that saw nothing is a row whose value cells are empty");
+    scan_.detection_probability = p.has("detection_probability") ? p.real("detection_probability") : std::numeric_limits<double>::quiet_NaN();
+    scan_.clutter_density = p.has("clutter_density") ? p.real("clutter_density") : std::numeric_limits<double>::quiet_NaN();
     const bool cartesian = p.choice<LogFrame>("frame") == LogFrame::Cartesian;
     frame_ = cartesian ? Frame::Cartesian : Frame::Spherical;
     // A parameter of the other frame would be silently ignored; say so instead.
@@ -315,6 +357,8 @@ class CsvSource final : public Generator {
     mode_ = column("mode_column");
     valid_ = column("valid_column");
     sensor_ = column("sensor_column");
+    scan_id_ = column("scan_column");
+    origin_ = column("origin_column");
 
     Measurement& m = prototype_;
     m.frame = cartesian ? Frame::Cartesian : Frame::Spherical;
@@ -348,7 +392,7 @@ class CsvSource final : public Generator {
       for (const auto& n : names) l += (l.empty() ? "" : ", ") + ("'" + n + "'");
       return l;
     };
-    for (Column* c : {&time_, &value_[0], &value_[1], &value_[2], &range_rate_, &snr_, &mode_, &valid_, &sensor_}) {
+    for (Column* c : columns()) {
       if (c->name.empty()) continue;
       int found = -1, count = 0;
       for (std::size_t i = 0; i < names.size(); ++i)
@@ -405,14 +449,16 @@ class CsvSource final : public Generator {
 
       log.header_line = header_line.number;
       log.field_count = field_count_;
-      const Column* columns[kColumns] = {&time_, &value_[0], &value_[1], &value_[2], &range_rate_, &snr_, &mode_, &valid_, &sensor_};
-      for (int i = 0; i < kColumns; ++i) log.column_index[i] = columns[i]->index;
+      for (int i = 0; i < kColumns; ++i) log.column_index[i] = columns()[i]->index;
       log.data_begin = reader.offset();
       log.data_end = end;
       log.last_terminated = log.stamp.size > end;
       log.first_data_line = header_line.number + 1;
 
       std::size_t longest = 0;
+      double group_time = 0.0;
+      std::uint32_t group_key = 0;
+      std::size_t group_size = 0;
       csv::Line line;
       std::string why;
       while (reader.next(line)) {
@@ -420,6 +466,15 @@ class CsvSource final : public Generator {
         longest = std::max(longest, line.text.size());
         if (read_row(line, reader.done(), fields, current_, &why)) {
           ++log.good_rows;
+          if (content_ == Content::Detections) {
+            if (log.scans == 0 || !same_scan(group_time, group_key, current_.time, row_scan_)) {
+              ++log.scans;
+              group_time = current_.time;
+              group_key = row_scan_;
+              group_size = 0;
+            }
+            if (!row_empty_) log.largest_scan = std::max(log.largest_scan, ++group_size);
+          }
           continue;
         }
         why = at(line.number) + why;
@@ -519,6 +574,14 @@ class CsvSource final : public Generator {
                       time_);
     }
     m.time = t;
+    if (scan_id_.read() && csv::parse_id(fields[scan_id_.index], row_scan_) != csv::CellStatus::Ok)
+      return complain("", "not a scan id (expected a non-negative integer)", scan_id_);
+    // A log of detections writes a look that saw nothing as a row without values.
+    row_empty_ = content_ == Content::Detections && no_values(fields);
+    if (row_empty_) {
+      remember_time(line, fields, t);
+      return true;
+    }
     for (int k = 0; k < 3; ++k) {
       double v = 0.0;
       if (!real(value_[k], v)) return false;
@@ -552,6 +615,27 @@ class CsvSource final : public Generator {
       return complain("", "not a validity flag (expected 1, 0, true or false)", valid_);
     if (sensor_.read() && csv::parse_id(fields[sensor_.index], m.sensor) != csv::CellStatus::Ok)
       return complain("", "not a sensor id (expected a non-negative integer)", sensor_);
+    m.origin = kOriginUnknown;
+    if (origin_.read()) {
+      const std::string_view o = fields[origin_.index];
+      if (csv::iequals(o, "clutter"))
+        m.origin = kOriginClutter;
+      else if (!csv::is_blank(o) && (csv::parse_id(o, m.origin) != csv::CellStatus::Ok || m.origin >= kOriginClutter))
+        return complain("", "not an origin (expected a target id, 'clutter', or nothing for unknown)", origin_);
+    }
+    remember_time(line, fields, t);
+    return true;
+  }
+
+  // Whether every value cell of the row (and its range rate's) is empty.
+  bool no_values(const std::vector<std::string_view>& fields) const {
+    for (const Column* c : {&value_[0], &value_[1], &value_[2], &range_rate_})
+      if (c->read() && !csv::is_blank(fields[c->index])) return false;
+    return true;
+  }
+
+  // The time order of the good rows: what a later row is compared with.
+  void remember_time(const csv::Line& line, const std::vector<std::string_view>& fields, double t) {
     has_previous_ = true;
     previous_time_ = t;
     // The line's text is gone once the stream reads on: keep what token() may quote of it (one
@@ -560,14 +644,14 @@ class CsvSource final : public Generator {
     previous_time_length_ = std::min(time_text.size(), sizeof previous_time_text_);
     std::memcpy(previous_time_text_, time_text.data(), previous_time_length_);
     previous_line_ = line.number;
-    return true;
   }
 
   // Configuration.
   std::string node_;
   bool skip_bad_rows_ = false;
   std::string file_;
-  Column time_, value_[3], range_rate_, snr_, mode_, valid_, sensor_;
+  Content content_ = Content::Measurements;
+  Column time_, value_[3], range_rate_, snr_, mode_, valid_, sensor_, scan_id_, origin_;
   double time_scale_ = 1.0, scale_[3] = {1.0, 1.0, 1.0}, rdot_scale_ = 1.0;
   Measurement prototype_;
   std::size_t field_count_ = 0;
@@ -588,6 +672,11 @@ class CsvSource final : public Generator {
   bool has_current_ = false;
   std::size_t replayed_ = 0, left_out_ = 0;  // good and bad rows of this run so far
   Frame frame_ = Frame::Spherical;
+  // content: detections — the scan being gathered, and what the last row read was.
+  std::vector<Detection> detections_;
+  Scan scan_;
+  std::uint32_t row_scan_ = 0;
+  bool row_empty_ = false;
 };
 
 std::vector<ParamSpec> csv_params() {
@@ -609,6 +698,16 @@ std::vector<ParamSpec> csv_params() {
       P::string("mode_column", "column with the track mode: beacon or skin (any case), anything else is unknown"),
       P::string("valid_column", "column with the validity flag: 1/0/true/false; invalid rows make filters coast"),
       P::string("sensor_column", "column with the sensor id (non-negative integer); overrides sensor_id"),
+      P::choice<Content>("content", {{Content::Measurements, "measurements"}, {Content::Detections, "detections"}},
+                         "what the source emits: one measurement per row, or scans of detections (rows grouped by "
+                         "scan_column, or by equal time)")
+          .def("measurements"),
+      P::string("scan_column", "detections: column with the scan number (non-negative integer); consecutive rows with "
+                               "the same number are one scan (default: rows of equal time)"),
+      P::string("origin_column", "column with each row's origin, for scoring: a target id, 'clutter', or empty (unknown)"),
+      P::real("detection_probability", dim::none, "detections: the P_D the scans state (default: not stated)").at_least(0).at_most(1),
+      P::real("clutter_density", Dimension{}, "detections: the clutter density the scans state, per unit of measurement "
+                                              "space (m3, or m rad2 for spherical; default: not stated)").at_least(0),
       P::choice<TimeUnit>("time_unit", {{TimeUnit::Second, "s"}, {TimeUnit::Millisecond, "ms"}}, "unit of the time column")
           .def("s"),
       length_unit_param("range_unit", "spherical: unit of range (and range rate per second)"),
@@ -647,11 +746,18 @@ void register_components(Registrar& r) {
           "Each bad row (not a number, NaN/inf, wrong field count, negative range, time going backwards, "
           "truncated last line) is reported as FILE:LINE; with on_bad_row: skip it is left out and counted. "
           "Accepts CRLF line endings and double-quoted fields without embedded commas. Metrics: rows (data rows "
-          "read), skipped_rows.";
+          "read), skipped_rows.\n"
+          "content: detections replays the log as scans (Scan items) for a tracker: consecutive rows of one scan "
+          "(the same scan_column value, or without it the same time) are the detections of one look, at its first "
+          "row's time and sensor; a row whose value cells are all empty is a look that saw nothing (a scan with "
+          "no detections, which a tracker counts as a miss for every track, unlike no scan at all). origin_column "
+          "labels rows for scoring (a target id, 'clutter', or empty for unknown); estimators never read it. The "
+          "scans state no region; their P_D and clutter density are the parameters' when given, else unknown "
+          "(NaN: give the associator its own). Metrics add scans.";
   d.params = csv_params();
   d.min_inputs = 0;
   d.max_inputs = 0;
-  d.produces = mask(ItemKind::Measurement);
+  d.produces = ItemKind::Measurement | ItemKind::Scan;  // one of the two, as `content` says (produced_kinds)
   d.time_ordered = true;  // rows out of time order are refused or skipped (on_bad_row)
   d.create = [](const Params& p) { return std::make_unique<CsvSource>(p); };
   r.add(std::move(d));

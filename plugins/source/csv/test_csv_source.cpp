@@ -513,3 +513,94 @@ TEST_CASE("a log rewritten after the check is an error in the run") {
     CHECK(out.measurements[3].value(0) == 200);
   }
 }
+
+namespace {
+
+struct RecordedScan {
+  double time = 0.0;
+  std::uint32_t sensor = 0;
+  std::vector<Detection> detections;
+  double pd = 0.0, density = 0.0;
+};
+
+class ScanRecorder final : public Component {
+ public:
+  void on_scan(const Scan& s, int) override {
+    scans.push_back({s.time, s.sensor.sensor, {s.detections.begin(), s.detections.end()}, s.detection_probability, s.clutter_density});
+  }
+  std::vector<RecordedScan> scans;
+};
+
+std::vector<RecordedScan> read_scans(const std::string& file, const std::string& extra) {
+  auto src = test::make("source.csv", yaml_params(file, "content: detections" + (extra.empty() ? "" : ", " + extra)));
+  CHECK(src->produced_kinds() == mask(ItemKind::Scan));
+  ScanRecorder rec;
+  Link link{&rec, 0, 0xFF};
+  src->out.connect(&link, 1);
+  test::drain(*src);
+  return rec.scans;
+}
+
+}  // namespace
+
+// A detection log: rows of equal time are one look, a row without values a look that saw nothing,
+// and the origin column labels each detection (target id, clutter, or unknown when empty).
+TEST_CASE("content detections groups rows of equal time into scans") {
+  TempDir dir;
+  const std::string file = dir.write("plots.csv",
+                                     "time,x,y,z,origin\n"
+                                     "1,10,20,0,3\n"
+                                     "1,-5,7,0,clutter\n"
+                                     "2,,,,\n"
+                                     "3,11,21,0,\n");
+  const auto scans = read_scans(file, "frame: cartesian, origin_column: origin, detection_probability: 0.9");
+  REQUIRE(scans.size() == 3);
+  CHECK(scans[0].time == 1.0);
+  REQUIRE(scans[0].detections.size() == 2);
+  CHECK(scans[0].detections[0].value[0] == 10.0);
+  CHECK(scans[0].detections[0].origin == 3);
+  CHECK(scans[0].detections[1].origin == kOriginClutter);
+  CHECK(scans[0].pd == 0.9);
+  CHECK(std::isnan(scans[0].density));
+  CHECK(scans[1].time == 2.0);
+  CHECK(scans[1].detections.empty());  // looked, saw nothing
+  REQUIRE(scans[2].detections.size() == 1);
+  CHECK(scans[2].detections[0].origin == kOriginUnknown);
+}
+
+// With a scan column, consecutive rows of one scan number are one look at its first row's time,
+// whatever their own times (a rotating radar time-stamps each plot).
+TEST_CASE("content detections groups rows by the scan column") {
+  TempDir dir;
+  const std::string file = dir.write("plots.csv",
+                                     "scan,time,range,azimuth,elevation\n"
+                                     "7,1.00,1000,10,1\n"
+                                     "7,1.25,2000,100,1\n"
+                                     "8,2.00,1500,50,2\n");
+  const auto scans = read_scans(file, "scan_column: scan");
+  REQUIRE(scans.size() == 2);
+  CHECK(scans[0].time == 1.0);
+  REQUIRE(scans[0].detections.size() == 2);
+  CHECK(scans[0].detections[1].value[1] == Approx(100 * kDeg));
+  CHECK(scans[1].detections.size() == 1);
+}
+
+TEST_CASE("content detections refuses what does not belong to it") {
+  TempDir dir;
+  const std::string file = dir.write("plots.csv", "time,range,azimuth,elevation,valid,scan,origin\n1,1000,10,1,1,x,-2\n");
+  auto refusal = [&](const std::string& extra) -> std::string {
+    try {
+      (void)test::make("source.csv", yaml_params(file, extra));
+    } catch (const std::exception& e) {
+      return e.what();
+    }
+    return {};
+  };
+  CHECK_THAT(refusal("scan_column: scan"), Catch::Contains("content: detections"));
+  CHECK_THAT(refusal("content: detections, valid_column: valid"), Catch::Contains("value cells are empty"));
+  CHECK_THAT(refusal("content: detections, scan_column: scan"), Catch::Contains("not a scan id"));
+  CHECK_THAT(refusal("content: detections, origin_column: origin"), Catch::Contains("not an origin"));
+  // A measurement log emits measurements only.
+  auto src = test::make("source.csv", yaml_params(file));
+  CHECK(src->produced_kinds() == mask(ItemKind::Measurement));
+}
