@@ -1,0 +1,237 @@
+// Purpose: the stream bookkeeping shared by the sinks that score each TrackSet against the truths of exactly its time (sink.gospa, sink.ospa): truth batches, the selected track positions, the per-run counters, the run means with their Student-t interval, and the per-step means over runs.
+#pragma once
+
+#include "scoring/track_set_sink.hpp"
+
+#include <trackflow/component.hpp>
+#include <trackflow/params.hpp>
+#include <trackflow/series.hpp>
+#include <trackflow/tracks.hpp>
+
+#include <Eigen/Core>
+
+#include <boost/math/distributions/students_t.hpp>
+
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <map>
+#include <span>
+#include <string>
+#include <vector>
+
+namespace trackflow::scoring {
+
+// Per run: what was left out or could not be paired in time. A field record (run_result_codec.hpp).
+struct TrackSetCounts {
+  std::uint64_t non_finite_tracks = 0;     // selected tracks with a non-finite position: left out
+  std::uint64_t non_finite_truths = 0;
+  std::uint64_t unscored_truth_steps = 0;  // truth batches with no TrackSet at their time
+  std::uint64_t steps_without_truth = 0;   // TrackSets with no truth at their time (scored against none)
+  std::uint64_t before_window = 0;         // TrackSets left out by skip_initial
+  template <class Self, class F>
+  static void fields(Self& r, F&& f) {
+    f(r.non_finite_tracks, r.non_finite_truths, r.unscored_truth_steps, r.steps_without_truth, r.before_window);
+  }
+  void add(const TrackSetCounts& o) {
+    non_finite_tracks += o.non_finite_tracks;
+    non_finite_truths += o.non_finite_truths;
+    unscored_truth_steps += o.unscored_truth_steps;
+    steps_without_truth += o.steps_without_truth;
+    before_window += o.before_window;
+  }
+};
+
+// Streams: truths of one time are kept until the next time's; each TrackSet is paired on arrival
+// with the truths of exactly its time stamp (they arrive first, in time order). Reads the
+// parameters of track_set_params(). Buffers keep their capacity between scans and runs.
+class TrackSetSteps {
+ public:
+  explicit TrackSetSteps(const Params& p)
+      : statuses_(parse_track_statuses(p)), planar_(planar_dimensions(p)), skip_initial_(p.real("skip_initial")) {}
+
+  bool planar() const { return planar_; }
+  const TrackSetCounts& counts() const { return counts_; }
+
+  void start_run() {
+    counts_ = TrackSetCounts{};
+    truth3_.clear();
+    truth2_.clear();
+    have_batch_ = batch_used_ = false;
+    first_set_ = std::numeric_limits<double>::quiet_NaN();
+  }
+
+  void on_truth(const Truth& t) {
+    if (!have_batch_ || t.time != batch_time_) {
+      close_batch();
+      have_batch_ = true;
+      batch_used_ = false;
+      batch_time_ = t.time;
+      truth3_.clear();
+      truth2_.clear();
+    }
+    if (!t.position.allFinite()) {
+      ++counts_.non_finite_truths;
+      return;
+    }
+    truth3_.push_back(t.position);
+    truth2_.push_back(t.position.head<2>());
+  }
+
+  // true when `set` is to be scored: then truths() and tracks() hold its time's positions.
+  bool on_tracks(const TrackSet& set) {
+    if (std::isnan(first_set_)) first_set_ = set.time;
+    const bool truth_now = have_batch_ && batch_time_ == set.time;
+    if (truth_now) batch_used_ = true;
+    if (set.time < first_set_ + skip_initial_) {
+      ++counts_.before_window;
+      return false;
+    }
+    track3_.clear();
+    track2_.clear();
+    for (const TrackEstimate& te : set.tracks) {
+      if (!status_selected(statuses_, te.status) || !te.estimate.initialised) continue;
+      const Vec3 pos = te.estimate.enu.head<3>();
+      if (planar_ ? !pos.head<2>().allFinite() : !pos.allFinite()) {
+        ++counts_.non_finite_tracks;
+        continue;
+      }
+      track3_.push_back(pos);
+      track2_.push_back(pos.head<2>());
+    }
+    if (!truth_now) {
+      ++counts_.steps_without_truth;
+      truth3_.clear();
+      truth2_.clear();
+    }
+    return true;
+  }
+
+  // The run's last truth batch counted if no TrackSet used it.
+  void end_run() {
+    close_batch();
+    have_batch_ = false;
+  }
+
+  std::size_t truths() const { return truth3_.size(); }
+  std::size_t tracks() const { return track3_.size(); }
+
+  // f(truth positions, track positions) as spans of Eigen::Vector2d or Eigen::Vector3d, as dimensions asks.
+  template <class F>
+  auto score(F&& f) const {
+    return planar_ ? f(std::span<const Eigen::Vector2d>(truth2_), std::span<const Eigen::Vector2d>(track2_))
+                   : f(std::span<const Eigen::Vector3d>(truth3_), std::span<const Eigen::Vector3d>(track3_));
+  }
+
+ private:
+  void close_batch() {
+    if (have_batch_ && !batch_used_) ++counts_.unscored_truth_steps;
+  }
+
+  const std::uint8_t statuses_;
+  const bool planar_;
+  const double skip_initial_;
+  TrackSetCounts counts_;
+  std::vector<Eigen::Vector3d> truth3_, track3_;
+  std::vector<Eigen::Vector2d> truth2_, track2_;
+  bool have_batch_ = false, batch_used_ = false;
+  double batch_time_ = 0.0, first_set_ = 0.0;
+};
+
+// The counters over runs as metrics (after the node's own): runs_scored, scored_steps,
+// non_finite_tracks, non_finite_truths (when any), unscored_truth_steps, steps_without_truth, and a
+// note naming what was left out.
+inline void publish_counts(Summary& s, std::uint64_t scored_runs, std::uint64_t steps, const TrackSetCounts& c) {
+  s.metric("runs_scored", static_cast<double>(scored_runs));
+  s.metric("scored_steps", static_cast<double>(steps));
+  s.metric("non_finite_tracks", static_cast<double>(c.non_finite_tracks));
+  if (c.non_finite_truths) s.metric("non_finite_truths", static_cast<double>(c.non_finite_truths));
+  s.metric("unscored_truth_steps", static_cast<double>(c.unscored_truth_steps));
+  s.metric("steps_without_truth", static_cast<double>(c.steps_without_truth));
+}
+
+inline void note_non_finite(Summary& s, const TrackSetCounts& c) {
+  if (c.non_finite_tracks || c.non_finite_truths)
+    s.notes.push_back("positions that are not finite were left out of the sets: " +
+                      std::to_string(c.non_finite_tracks) + " tracks, " + std::to_string(c.non_finite_truths) +
+                      " truths");
+}
+
+// Means over runs of N per-run means, and a 95 % Student-t interval of the mean of the run means.
+template <int N>
+class RunMeans {
+ public:
+  // One run's sums over its `steps` scored steps (none: not counted).
+  void add(const std::array<double, N>& sums, std::uint64_t steps) {
+    if (!steps) return;
+    ++runs_;
+    const double n = static_cast<double>(steps);
+    for (int i = 0; i < N; ++i) {
+      sum_[i] += sums[i] / n;
+      sq_[i] += (sums[i] / n) * (sums[i] / n);
+    }
+  }
+  std::uint64_t runs() const { return runs_; }
+  double mean(int i) const { return sum_[i] / static_cast<double>(runs_); }
+  // Half-width of the interval around mean(i); two runs or more.
+  double ci95_half(int i) const {
+    const double runs = static_cast<double>(runs_);
+    const double m = mean(i);
+    const double var = std::max(0.0, (sq_[i] - runs * m * m) / (runs - 1.0));
+    const boost::math::students_t t(runs - 1.0);
+    return boost::math::quantile(boost::math::complement(t, 0.025)) * std::sqrt(var / runs);
+  }
+
+ private:
+  std::uint64_t runs_ = 0;
+  double sum_[N] = {}, sq_[N] = {};
+};
+
+// Per time step (keyed to the microsecond), sums over the runs that scored a set at that step of N
+// values; published as a Series of their means with columns time, runs and the chosen values.
+template <int N>
+class StepMeans {
+ public:
+  bool empty() const { return steps_.empty(); }
+  void add(double time, const std::array<double, N>& x) {
+    Step& st = steps_[std::llround(time * 1e6)];
+    st.time = time;
+    ++st.runs;
+    for (int i = 0; i < N; ++i) st.v[i] += x[i];
+  }
+  // Columns names[i] (unit units[i]) for the i where keep(i).
+  template <class Keep>
+  Series series(std::string name, std::string description, const std::array<const char*, N>& names,
+                const std::array<std::string, N>& units, Keep keep) const {
+    Series out;
+    out.name = std::move(name);
+    out.description = std::move(description);
+    out.add_column("time", "s");
+    out.add_column("runs");
+    for (int i = 0; i < N; ++i)
+      if (keep(i)) out.add_column(names[i], units[i]);
+    out.values.reserve(steps_.size() * out.columns.size());
+    for (const auto& [key, st] : steps_) {
+      out.values.push_back(st.time);
+      out.values.push_back(static_cast<double>(st.runs));
+      for (int i = 0; i < N; ++i)
+        if (keep(i)) out.values.push_back(st.v[i] / static_cast<double>(st.runs));
+    }
+    return out;
+  }
+
+ private:
+  struct Step {
+    double time = 0.0;
+    std::uint64_t runs = 0;
+    double v[N] = {};
+  };
+  std::map<long long, Step> steps_;
+};
+
+// The unit of a p-th power of a distance: m for p = 1, m2 for p = 2, none otherwise.
+inline std::string pow_p_unit(double order) { return order == 1.0 ? "m" : order == 2.0 ? "m2" : ""; }
+
+}  // namespace trackflow::scoring

@@ -1,0 +1,158 @@
+// Purpose: sink.ospa — OSPA of Schuhmacher, Vo and Vo (2008) between truth and a tracker's track sets, with its localisation and cardinality terms, per scan, Monte Carlo means and a per-step series.
+#include "scoring/gospa.hpp"
+#include "scoring/track_set_sink.hpp"
+#include "scoring/track_set_steps.hpp"
+
+#include <trackflow/number_text.hpp>
+#include <trackflow/plugin.hpp>
+#include <trackflow/run_result_codec.hpp>
+#include <trackflow/tracks.hpp>
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace trackflow {
+namespace {
+
+constexpr int kValues = 6;
+using Values = std::array<double, kValues>;
+constexpr std::array<const char*, kValues> kNames = {"ospa",   "ospa_pow_p", "ospa_localisation", "ospa_cardinality",
+                                                     "truths", "tracks"};
+
+// One scored TrackSet: kNames' values (counts as doubles).
+struct OspaStep {
+  double time = 0.0;
+  Values v = {};
+};
+
+struct OspaRunResult final : RunResult {
+  std::uint64_t steps = 0;
+  Values sum = {};  // over the scored steps
+  scoring::TrackSetCounts counts;
+  std::vector<OspaStep> series;  // per scored step, when `series`
+  template <class Self, class F>
+  static void fields(Self& r, F&& f) {
+    f(r.steps, r.sum, r.counts, r.series);
+  }
+};
+
+// OSPA's optimal assignment is GOSPA's (for any alpha: the penalty of the left-over elements does
+// not depend on the assignment), so metrics::Gospa scores it; alpha is not used here.
+class OspaSink final : public Component, public FieldListCodec<OspaRunResult> {
+ public:
+  explicit OspaSink(const Params& p)
+      : ospa_(p.real("cutoff"), p.real("order")), steps_in_(p), series_(p.boolean("series")) {}
+
+  void set_inputs(const std::vector<InputInfo>& inputs) override { scoring::check_track_set_inputs(inputs, "sink.ospa"); }
+
+  void start_run(const RunContext&) override {
+    run_.steps = 0;
+    run_.sum = {};
+    run_.series.clear();  // keeps its capacity
+    steps_in_.start_run();
+  }
+
+  void on_truth(const Truth& t, int) override { steps_in_.on_truth(t); }
+
+  void on_tracks(const TrackSet& set, int) override {
+    if (!steps_in_.on_tracks(set)) return;
+    const metrics::GospaResult r = steps_in_.score([this](auto truth, auto tracks) { return ospa_.evaluate(truth, tracks); });
+    const OspaStep s{set.time,
+                     {r.ospa, r.ospa_localisation + r.ospa_cardinality, r.ospa_localisation, r.ospa_cardinality,
+                      double(steps_in_.truths()), double(steps_in_.tracks())}};
+    ++run_.steps;
+    for (int i = 0; i < kValues; ++i) run_.sum[i] += s.v[i];
+    if (series_) run_.series.push_back(s);
+  }
+
+  std::unique_ptr<RunResult> end_run() override {
+    steps_in_.end_run();
+    run_.counts = steps_in_.counts();
+    return std::make_unique<OspaRunResult>(run_);
+  }
+
+  void merge(RunResult& result) override {
+    const auto& r = static_cast<const OspaRunResult&>(result);
+    counts_.add(r.counts);
+    steps_ += r.steps;
+    means_.add(r.sum, r.steps);
+    for (const OspaStep& g : r.series) by_time_.add(g.time, g.v);
+  }
+
+  void finish(Summary& s, const FinishContext&) override {
+    const std::string unit_p = scoring::pow_p_unit(ospa_.order());
+    const std::array<std::string, kValues> units = {"m", unit_p, unit_p, unit_p, "", ""};
+    if (means_.runs()) {
+      for (int i = 0; i < kValues; ++i) {
+        s.metric(kNames[static_cast<std::size_t>(i)], means_.mean(i), units[static_cast<std::size_t>(i)]);
+        if (i == 0 && means_.runs() >= 2) {
+          const double half = means_.ci95_half(0);
+          s.metric("ospa_ci95_lo", means_.mean(0) - half, "m");
+          s.metric("ospa_ci95_hi", means_.mean(0) + half, "m");
+        }
+      }
+    }
+    scoring::publish_counts(s, means_.runs(), steps_, counts_);
+    s.notes.push_back("OSPA (c = " + number_text::general(ospa_.cutoff(), 6) + " m, p = " +
+                      number_text::general(ospa_.order(), 6) +
+                      ") per TrackSet against the truths of exactly its time; ospa: mean over a run's steps of d, "
+                      "then over runs; ospa_pow_p: the same of d^p, = ospa_localisation + ospa_cardinality (the "
+                      "two terms of d^p, each divided by the larger set's size)");
+    scoring::note_non_finite(s, counts_);
+    if (series_ && !by_time_.empty())
+      s.series.push_back(by_time_.series("ospa",
+                                         "per time step, means over the runs with a track set at that step: OSPA, "
+                                         "its p-th power and its localisation and cardinality terms, truths, tracks",
+                                         kNames, units, [](int) { return true; }));
+  }
+
+ private:
+  metrics::Gospa ospa_;
+  scoring::TrackSetSteps steps_in_;
+  const bool series_;
+
+  OspaRunResult run_;
+  std::uint64_t steps_ = 0;
+  scoring::TrackSetCounts counts_;
+  scoring::RunMeans<kValues> means_;
+  scoring::StepMeans<kValues> by_time_;
+};
+
+void register_components(Registrar& r) {
+  ComponentDecl d;
+  d.type = "sink.ospa";
+  d.kind = ComponentKind::Sink;
+  d.summary = "OSPA (localisation / cardinality terms) of a tracker's track sets against truth";
+  d.doc =
+      "Inputs: a tracker's track sets and truth, e.g. inputs: [tracker, scenario]. Each TrackSet is scored on "
+      "arrival against the truths whose time equals its time exactly (they arrive first, in time order): OSPA "
+      "d_p^(c) of Schuhmacher, Vo and Vo (IEEE Trans. Signal Processing 56(8), 2008), "
+      "( (min_pi sum_{i<=m} min(c, d(x_i, y_pi(i)))^p + c^p (n - m)) / n )^(1/p) for m = min(|X|, |Y|), "
+      "n = max(|X|, |Y|); 0 when both sets are empty, c when exactly one is. Tracks of the chosen statuses "
+      "(initialised, finite positions), in x-y-z or x-y (dimensions: 2); the same pairing of track sets and "
+      "truths as sink.gospa (steps_without_truth, unscored_truth_steps). Per run: means over its scored steps; "
+      "metrics are the means of those over runs: ospa (of d), ospa_pow_p (of d^p), ospa_localisation and "
+      "ospa_cardinality (the two terms of d^p, each divided by n, summing to ospa_pow_p; the paper's components "
+      "are their p-th roots), truths and tracks per step, and a 95 % Student-t interval of the run means of ospa "
+      "(ospa_ci95_lo/hi, two runs or more). Series `ospa`: the same per time step over runs. "
+      "docs/multi-target-metrics.md.";
+  d.params = {
+      ParamSpec::real("cutoff", dim::length, "cut-off distance c").req().positive(),
+      ParamSpec::real("order", dim::none, "order p, >= 1").def("2").at_least(1),
+      ParamSpec::boolean("series", "publish the per-step series (kept per step in each run)").def("true"),
+  };
+  for (ParamSpec& spec : scoring::track_set_params()) d.params.push_back(std::move(spec));
+  d.accepts = ItemKind::Tracks | ItemKind::Truth;
+  d.min_inputs = 2;
+  d.max_inputs = -1;
+  d.produces = 0;
+  d.create = [](const Params& p) { return std::make_unique<OspaSink>(p); };
+  r.add(std::move(d));
+}
+
+}  // namespace
+}  // namespace trackflow
+
+TRACKFLOW_PLUGIN("sink.ospa", trackflow::register_components)
