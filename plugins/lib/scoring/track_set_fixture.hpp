@@ -105,4 +105,24 @@ inline void check_refused(const std::string& type, const std::string& yaml, cons
   FAIL("accepted: " << yaml);
 }
 
+// `runs` runs of feed(sink, run) on one sink made by make(); each run's result is merged into a
+// second sink as it is and into a third after the codec: both summaries must be the same.
+template <class Make, class Feed>
+void check_codec_round_trip(Make make, Feed feed, int runs = 3) {
+  auto s = make(), direct = make(), decoded = make();
+  for (int run = 0; run < runs; ++run) {
+    start_run(*s, static_cast<std::uint64_t>(run));
+    feed(*s, run);
+    auto r = s->end_run();
+    if (!r) continue;  // a sink that records one run only
+    auto back = through_codec(*s, *decoded, *r);
+    direct->merge(*r);
+    decoded->merge(*back);
+  }
+  Summary a, b;
+  direct->finish(a, {});
+  decoded->finish(b, {});
+  check_same_summary(a, b);
+}
+
 }  // namespace trackflow::test

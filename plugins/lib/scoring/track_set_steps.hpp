@@ -5,6 +5,8 @@
 
 #include <trackflow/component.hpp>
 #include <trackflow/params.hpp>
+#include <trackflow/registry.hpp>
+#include <trackflow/run_result_codec.hpp>
 #include <trackflow/series.hpp>
 #include <trackflow/tracks.hpp>
 
@@ -18,8 +20,10 @@
 #include <cstdint>
 #include <limits>
 #include <map>
+#include <memory>
 #include <span>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace trackflow::scoring {
@@ -230,6 +234,106 @@ class StepMeans {
   };
   std::map<long long, Step> steps_;
 };
+
+// One scored step: its time and the sink's N values.
+template <int N>
+struct TimedValues {
+  double time = 0.0;
+  std::array<double, N> v = {};
+};
+
+// A track-set sink's per-run result: sums over the scored steps, counts, and (when `series`) each
+// step. A field record, so that FieldListCodec<StepRunResult<N>> is its codec under mpirun.
+template <int N>
+struct StepRunResult final : RunResult {
+  std::uint64_t steps = 0;
+  std::array<double, N> sum = {};
+  TrackSetCounts counts;
+  std::vector<TimedValues<N>> series;
+  template <class Self, class F>
+  static void fields(Self& r, F&& f) {
+    f(r.steps, r.sum, r.counts, r.series);
+  }
+};
+
+// Everything of a track-set sink but its metric, with N values per scored step: the pairing of
+// sets with truths (TrackSetSteps), the run's sums, the merge into run means and per-step means.
+// The sink forwards its stream calls here, scores a set with score() when on_tracks() says so,
+// hands the step's values to add(), and publishes from means() and by_time() in finish().
+// Reads the parameters of track_set_params() and `series`.
+template <int N>
+class TrackSetScores {
+ public:
+  using Values = std::array<double, N>;
+  explicit TrackSetScores(const Params& p) : steps_in_(p), series_(p.boolean("series")) {}
+
+  void start_run() {
+    run_.steps = 0;
+    run_.sum = {};
+    run_.series.clear();  // keeps its capacity
+    steps_in_.start_run();
+  }
+  void on_truth(const Truth& t) { steps_in_.on_truth(t); }
+  bool on_tracks(const TrackSet& set) { return steps_in_.on_tracks(set); }
+  const TrackSetSteps& steps() const { return steps_in_; }
+  template <class F>
+  auto score(F&& f) const {
+    return steps_in_.score(std::forward<F>(f));
+  }
+  void add(double time, const Values& v) {
+    ++run_.steps;
+    for (int i = 0; i < N; ++i) run_.sum[i] += v[i];
+    if (series_) run_.series.push_back({time, v});
+  }
+  std::unique_ptr<RunResult> end_run() {
+    steps_in_.end_run();
+    run_.counts = steps_in_.counts();
+    return std::make_unique<StepRunResult<N>>(run_);
+  }
+  void merge(const RunResult& result) {
+    const auto& r = static_cast<const StepRunResult<N>&>(result);
+    counts_.add(r.counts);
+    steps_ += r.steps;
+    means_.add(r.sum, r.steps);
+    for (const TimedValues<N>& g : r.series) by_time_.add(g.time, g.v);
+  }
+
+  const RunMeans<N>& means() const { return means_; }
+  // The per-step means, when `series` and any step was scored.
+  const StepMeans<N>* by_time() const { return series_ && !by_time_.empty() ? &by_time_ : nullptr; }
+  // The counters as metrics and the note on non-finite positions (publish_counts, note_non_finite).
+  void publish_counts(Summary& s) const { scoring::publish_counts(s, means_.runs(), steps_, counts_); }
+  void note_non_finite(Summary& s) const { scoring::note_non_finite(s, counts_); }
+
+ private:
+  TrackSetSteps steps_in_;
+  const bool series_;
+  StepRunResult<N> run_;
+  std::uint64_t steps_ = 0;
+  TrackSetCounts counts_;
+  RunMeans<N> means_;
+  StepMeans<N> by_time_;
+};
+
+// The cut-off c and order p of a set metric (GOSPA, OSPA), the first parameters of its sink.
+inline std::vector<ParamSpec> cutoff_order_params() {
+  return {
+      ParamSpec::real("cutoff", dim::length, "cut-off distance c").req().positive(),
+      ParamSpec::real("order", dim::none, "order p, >= 1").def("2").at_least(1),
+  };
+}
+
+// What a sink built on TrackSetScores declares after its own parameters: `series` and
+// track_set_params(); inputs of track sets and truth (two or more); nothing produced.
+inline void declare_track_set_scores(ComponentDecl& d) {
+  d.params.push_back(ParamSpec::boolean("series", "publish the per-step series (kept per step in each run)").def("true"));
+  for (ParamSpec& spec : track_set_params()) d.params.push_back(std::move(spec));
+  d.kind = ComponentKind::Sink;
+  d.accepts = ItemKind::Tracks | ItemKind::Truth;
+  d.min_inputs = 2;
+  d.max_inputs = -1;
+  d.produces = 0;
+}
 
 // The unit of a p-th power of a distance: m for p = 1, m2 for p = 2, none otherwise.
 inline std::string pow_p_unit(double order) { return order == 1.0 ? "m" : order == 2.0 ? "m2" : ""; }

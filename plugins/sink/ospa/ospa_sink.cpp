@@ -18,91 +18,52 @@ namespace {
 
 constexpr int kValues = 6;
 using Values = std::array<double, kValues>;
+// Per scored TrackSet, in this order (counts as doubles).
 constexpr std::array<const char*, kValues> kNames = {"ospa",   "ospa_pow_p", "ospa_localisation", "ospa_cardinality",
                                                      "truths", "tracks"};
 
-// One scored TrackSet: kNames' values (counts as doubles).
-struct OspaStep {
-  double time = 0.0;
-  Values v = {};
-};
-
-struct OspaRunResult final : RunResult {
-  std::uint64_t steps = 0;
-  Values sum = {};  // over the scored steps
-  scoring::TrackSetCounts counts;
-  std::vector<OspaStep> series;  // per scored step, when `series`
-  template <class Self, class F>
-  static void fields(Self& r, F&& f) {
-    f(r.steps, r.sum, r.counts, r.series);
-  }
-};
-
 // OSPA's optimal assignment is GOSPA's (for any alpha: the penalty of the left-over elements does
-// not depend on the assignment), so metrics::Gospa scores it; alpha is not used here.
-class OspaSink final : public Component, public FieldListCodec<OspaRunResult> {
+// not depend on the assignment), so metrics::Gospa scores it; alpha is not used here. Each
+// TrackSet is scored on arrival against the truths of its time (scoring::TrackSetScores).
+class OspaSink final : public Component, public FieldListCodec<scoring::StepRunResult<kValues>> {
  public:
-  explicit OspaSink(const Params& p)
-      : ospa_(p.real("cutoff"), p.real("order")), steps_in_(p), series_(p.boolean("series")) {}
+  explicit OspaSink(const Params& p) : ospa_(p.real("cutoff"), p.real("order")), scores_(p) {}
 
   void set_inputs(const std::vector<InputInfo>& inputs) override { scoring::check_track_set_inputs(inputs, "sink.ospa"); }
-
-  void start_run(const RunContext&) override {
-    run_.steps = 0;
-    run_.sum = {};
-    run_.series.clear();  // keeps its capacity
-    steps_in_.start_run();
-  }
-
-  void on_truth(const Truth& t, int) override { steps_in_.on_truth(t); }
+  void start_run(const RunContext&) override { scores_.start_run(); }
+  void on_truth(const Truth& t, int) override { scores_.on_truth(t); }
 
   void on_tracks(const TrackSet& set, int) override {
-    if (!steps_in_.on_tracks(set)) return;
-    const metrics::GospaResult r = steps_in_.score([this](auto truth, auto tracks) { return ospa_.evaluate(truth, tracks); });
-    const OspaStep s{set.time,
-                     {r.ospa, r.ospa_localisation + r.ospa_cardinality, r.ospa_localisation, r.ospa_cardinality,
-                      double(steps_in_.truths()), double(steps_in_.tracks())}};
-    ++run_.steps;
-    for (int i = 0; i < kValues; ++i) run_.sum[i] += s.v[i];
-    if (series_) run_.series.push_back(s);
+    if (!scores_.on_tracks(set)) return;
+    const metrics::GospaResult r = scores_.score([this](auto truth, auto tracks) { return ospa_.evaluate(truth, tracks); });
+    scores_.add(set.time, {r.ospa, r.ospa_localisation + r.ospa_cardinality, r.ospa_localisation, r.ospa_cardinality,
+                           double(scores_.steps().truths()), double(scores_.steps().tracks())});
   }
 
-  std::unique_ptr<RunResult> end_run() override {
-    steps_in_.end_run();
-    run_.counts = steps_in_.counts();
-    return std::make_unique<OspaRunResult>(run_);
-  }
-
-  void merge(RunResult& result) override {
-    const auto& r = static_cast<const OspaRunResult&>(result);
-    counts_.add(r.counts);
-    steps_ += r.steps;
-    means_.add(r.sum, r.steps);
-    for (const OspaStep& g : r.series) by_time_.add(g.time, g.v);
-  }
+  std::unique_ptr<RunResult> end_run() override { return scores_.end_run(); }
+  void merge(RunResult& result) override { scores_.merge(result); }
 
   void finish(Summary& s, const FinishContext&) override {
     const std::string unit_p = scoring::pow_p_unit(ospa_.order());
     const std::array<std::string, kValues> units = {"m", unit_p, unit_p, unit_p, "", ""};
-    if (means_.runs()) {
-      for (int i = 0; i < kValues; ++i) {
-        s.metric(kNames[static_cast<std::size_t>(i)], means_.mean(i), units[static_cast<std::size_t>(i)]);
-        if (i == 0 && means_.runs() >= 2) {
-          const double half = means_.ci95_half(0);
-          s.metric("ospa_ci95_lo", means_.mean(0) - half, "m");
-          s.metric("ospa_ci95_hi", means_.mean(0) + half, "m");
-        }
+    const auto& means = scores_.means();
+    for (int i = 0; i < kValues && means.runs(); ++i) {
+      s.metric(kNames[static_cast<std::size_t>(i)], means.mean(i), units[static_cast<std::size_t>(i)]);
+      if (i == 0 && means.runs() >= 2) {
+        const double half = means.ci95_half(0);
+        s.metric("ospa_ci95_lo", means.mean(0) - half, "m");
+        s.metric("ospa_ci95_hi", means.mean(0) + half, "m");
       }
     }
-    scoring::publish_counts(s, means_.runs(), steps_, counts_);
+    scores_.publish_counts(s);
     s.notes.push_back("OSPA (c = " + number_text::general(ospa_.cutoff(), 6) + " m, p = " +
                       number_text::general(ospa_.order(), 6) +
                       ") per TrackSet against the truths of exactly its time; ospa: mean over a run's steps of d, "
                       "then over runs; ospa_pow_p: the same of d^p, = ospa_localisation + ospa_cardinality (the "
                       "two terms of d^p, each divided by the larger set's size)");
-    scoring::note_non_finite(s, counts_);
-    if (series_ && !by_time_.empty())
-      s.series.push_back(by_time_.series("ospa",
+    scores_.note_non_finite(s);
+    if (const auto* by_time = scores_.by_time())
+      s.series.push_back(by_time->series("ospa",
                                          "per time step, means over the runs with a track set at that step: OSPA, "
                                          "its p-th power and its localisation and cardinality terms, truths, tracks",
                                          kNames, units, [](int) { return true; }));
@@ -110,20 +71,12 @@ class OspaSink final : public Component, public FieldListCodec<OspaRunResult> {
 
  private:
   metrics::Gospa ospa_;
-  scoring::TrackSetSteps steps_in_;
-  const bool series_;
-
-  OspaRunResult run_;
-  std::uint64_t steps_ = 0;
-  scoring::TrackSetCounts counts_;
-  scoring::RunMeans<kValues> means_;
-  scoring::StepMeans<kValues> by_time_;
+  scoring::TrackSetScores<kValues> scores_;
 };
 
 void register_components(Registrar& r) {
   ComponentDecl d;
   d.type = "sink.ospa";
-  d.kind = ComponentKind::Sink;
   d.summary = "OSPA (localisation / cardinality terms) of a tracker's track sets against truth";
   d.doc =
       "Inputs: a tracker's track sets and truth, e.g. inputs: [tracker, scenario]. Each TrackSet is scored on "
@@ -138,16 +91,8 @@ void register_components(Registrar& r) {
       "are their p-th roots), truths and tracks per step, and a 95 % Student-t interval of the run means of ospa "
       "(ospa_ci95_lo/hi, two runs or more). Series `ospa`: the same per time step over runs. "
       "docs/multi-target-metrics.md.";
-  d.params = {
-      ParamSpec::real("cutoff", dim::length, "cut-off distance c").req().positive(),
-      ParamSpec::real("order", dim::none, "order p, >= 1").def("2").at_least(1),
-      ParamSpec::boolean("series", "publish the per-step series (kept per step in each run)").def("true"),
-  };
-  for (ParamSpec& spec : scoring::track_set_params()) d.params.push_back(std::move(spec));
-  d.accepts = ItemKind::Tracks | ItemKind::Truth;
-  d.min_inputs = 2;
-  d.max_inputs = -1;
-  d.produces = 0;
+  d.params = scoring::cutoff_order_params();
+  scoring::declare_track_set_scores(d);
   d.create = [](const Params& p) { return std::make_unique<OspaSink>(p); };
   r.add(std::move(d));
 }
