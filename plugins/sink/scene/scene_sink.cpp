@@ -1,4 +1,6 @@
 // Purpose: sink.scene — records one run's truths by target, tracks by id and status, and scan detections (clutter or target-originated) in ENU, capped in size, for the report's multi-target picture.
+#include "recording/port_streams.hpp"
+
 #include <trackflow/geometry.hpp>
 #include <trackflow/plugin.hpp>
 #include <trackflow/run_result_codec.hpp>
@@ -23,18 +25,10 @@ struct Point {
   double p[3];
 };
 
-// One recorded stream: an input port and one item kind.
-struct Stream {
-  ItemKind kind;
-  std::vector<Point> points;
-  template <class Self, class F>
-  static void fields(Self& s, F&& f) {
-    f(s.kind, s.points);
-  }
-};
+using Stream = recording::Stream<Point>;
 
 struct SceneRunResult final : RunResult {
-  std::vector<Stream> streams;       // by input port x kind, as laid out in set_inputs
+  std::vector<Stream> streams;       // by input port x kind, as laid out by PortStreams
   std::uint64_t clutter_stride = 1;  // clutter kept of every k-th scan only
   std::uint64_t not_recorded = 0;    // points past max_points once no clutter was left to thin
   template <class Self, class F>
@@ -55,23 +49,14 @@ class SceneSink final : public Component, public FieldListCodec<SceneRunResult> 
       : run_(static_cast<std::uint64_t>(p.integer("run"))), max_points_(static_cast<std::size_t>(p.integer("max_points"))) {}
 
   void set_inputs(const std::vector<InputInfo>& inputs) override {
-    index_.assign(inputs.size() * 3, -1);
-    rec_.streams.clear();
-    names_.clear();
-    for (size_t port = 0; port < inputs.size(); ++port)
-      for (int k = 0; k < 3; ++k)
-        if (inputs[port].kinds & mask(kKinds[k])) {
-          index_[port * 3 + static_cast<size_t>(k)] = static_cast<int>(rec_.streams.size());
-          rec_.streams.push_back({kKinds[k], {}});
-          names_.push_back(std::string(to_string(kKinds[k])) + ":" + inputs[port].node);
-        }
-    scans_.assign(rec_.streams.size(), 0);
+    streams_.lay_out(inputs, kKinds);
+    scans_.assign(streams_.streams().size(), 0);
   }
 
   void start_run(const RunContext& ctx) override {
     active_ = ctx.run == run_;
     if (!active_) return;
-    for (auto& s : rec_.streams) s.points.clear();
+    for (auto& s : streams_.streams()) s.points.clear();
     std::fill(scans_.begin(), scans_.end(), 0);
     rec_.clutter_stride = 1;
     rec_.not_recorded = 0;
@@ -85,7 +70,7 @@ class SceneSink final : public Component, public FieldListCodec<SceneRunResult> 
   void on_scan(const Scan& scan, int port) override {
     Stream* s = stream(port, 1);
     if (!s || !scan.valid) return;
-    const std::uint64_t index = scans_[static_cast<size_t>(s - rec_.streams.data())]++;
+    const std::uint64_t index = scans_[static_cast<size_t>(s - streams_.streams().data())]++;
     Measurement m;
     for (const Detection& d : scan.detections) {
       const bool clutter = d.origin == kOriginClutter;
@@ -112,7 +97,9 @@ class SceneSink final : public Component, public FieldListCodec<SceneRunResult> 
   std::unique_ptr<RunResult> end_run() override {
     if (!active_) return nullptr;
     active_ = false;
-    return std::make_unique<SceneRunResult>(rec_);
+    auto r = std::make_unique<SceneRunResult>(rec_);
+    r->streams = streams_.streams();
+    return r;
   }
 
   void merge(RunResult& result) override {
@@ -131,7 +118,7 @@ class SceneSink final : public Component, public FieldListCodec<SceneRunResult> 
       const Stream& st = recorded_.streams[i];
       const int k = st.kind == ItemKind::Truth ? 0 : st.kind == ItemKind::Scan ? 1 : 2;
       Series s;
-      s.name = names_[i];
+      s.name = streams_.names()[i];
       s.description = std::string(k == 0   ? "truths by target"
                                   : k == 1 ? "scan detections (origin: target id, -1 clutter, -2 unknown)"
                                            : "tracks by id (status: 0 tentative, 1 confirmed, 2 coasting)") +
@@ -161,11 +148,7 @@ class SceneSink final : public Component, public FieldListCodec<SceneRunResult> 
   }
 
  private:
-  Stream* stream(int port, int k) {
-    if (!active_ || port < 0 || static_cast<size_t>(port) * 3 >= index_.size()) return nullptr;
-    const int i = index_[static_cast<size_t>(port) * 3 + static_cast<size_t>(k)];
-    return i < 0 ? nullptr : &rec_.streams[static_cast<size_t>(i)];
-  }
+  Stream* stream(int port, std::size_t slot) { return active_ ? streams_.find(port, slot) : nullptr; }
 
   void keep(Stream& s, const Point& p) {
     while (total_ >= max_points_ && thin_clutter()) {
@@ -184,28 +167,27 @@ class SceneSink final : public Component, public FieldListCodec<SceneRunResult> 
   // no clutter is recorded (nothing to thin).
   bool thin_clutter() {
     bool any = false;
-    for (auto& s : rec_.streams)
+    for (auto& s : streams_.streams())
       if (s.kind == ItemKind::Scan)
         for (const Point& p : s.points) any |= p.id == kClutter;
     if (!any) return false;
     rec_.clutter_stride *= 2;
-    for (auto& s : rec_.streams) {
+    for (auto& s : streams_.streams()) {
       if (s.kind != ItemKind::Scan) continue;
       std::erase_if(s.points, [&](const Point& p) {
         return p.id == kClutter && static_cast<std::uint64_t>(p.tag) % rec_.clutter_stride != 0;
       });
     }
     total_ = 0;
-    for (const auto& s : rec_.streams) total_ += s.points.size();
+    for (const auto& s : streams_.streams()) total_ += s.points.size();
     return true;
   }
 
   const std::uint64_t run_;
   const std::size_t max_points_;
-  std::vector<int> index_;  // (port, kind) -> stream
-  std::vector<std::string> names_;
+  recording::PortStreams<Point> streams_;
   std::vector<std::uint64_t> scans_;  // per stream: valid scans seen in the run
-  SceneRunResult rec_;
+  SceneRunResult rec_;                // the run's stride and count (its streams: streams_)
   std::size_t total_ = 0;
   bool active_ = false;
   // Aggregating instance.
