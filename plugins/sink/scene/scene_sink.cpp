@@ -60,7 +60,7 @@ class SceneSink final : public Component, public FieldListCodec<SceneRunResult> 
     std::fill(scans_.begin(), scans_.end(), 0);
     rec_.clutter_stride = 1;
     rec_.not_recorded = 0;
-    total_ = 0;
+    total_ = thinnable_ = 0;
   }
 
   void on_truth(const Truth& t, int port) override {
@@ -151,8 +151,7 @@ class SceneSink final : public Component, public FieldListCodec<SceneRunResult> 
   Stream* stream(int port, std::size_t slot) { return active_ ? streams_.find(port, slot) : nullptr; }
 
   void keep(Stream& s, const Point& p) {
-    while (total_ >= max_points_ && thin_clutter()) {
-    }
+    while (total_ >= max_points_ && thinnable_ > 0) thin_clutter();
     // Clutter of a scan the stride (just doubled) leaves out is thinned, as the note says.
     if (p.id == kClutter && static_cast<std::uint64_t>(p.tag) % rec_.clutter_stride != 0) return;
     if (total_ >= max_points_) {
@@ -161,26 +160,23 @@ class SceneSink final : public Component, public FieldListCodec<SceneRunResult> 
     }
     s.points.push_back(p);
     ++total_;
+    if (p.id == kClutter && p.tag != 0.0) ++thinnable_;
   }
 
-  // Doubles the clutter stride and drops the clutter of the scans it now leaves out; false when
-  // no clutter is recorded (nothing to thin).
-  bool thin_clutter() {
-    bool any = false;
-    for (auto& s : streams_.streams())
-      if (s.kind == ItemKind::Scan)
-        for (const Point& p : s.points) any |= p.id == kClutter;
-    if (!any) return false;
+  // Doubles the clutter stride and drops the clutter of the scans it now leaves out. Scan 0's
+  // clutter stays at any stride, so only the clutter of later scans (thinnable_ of it, counted as
+  // kept, so that a full recorder costs no pass over its points per item) can be thinned.
+  void thin_clutter() {
     rec_.clutter_stride *= 2;
+    total_ = thinnable_ = 0;
     for (auto& s : streams_.streams()) {
-      if (s.kind != ItemKind::Scan) continue;
-      std::erase_if(s.points, [&](const Point& p) {
-        return p.id == kClutter && static_cast<std::uint64_t>(p.tag) % rec_.clutter_stride != 0;
-      });
+      if (s.kind == ItemKind::Scan)
+        std::erase_if(s.points, [&](const Point& p) {
+          return p.id == kClutter && static_cast<std::uint64_t>(p.tag) % rec_.clutter_stride != 0;
+        });
+      total_ += s.points.size();
+      for (const Point& p : s.points) thinnable_ += p.id == kClutter && p.tag != 0.0 ? 1 : 0;
     }
-    total_ = 0;
-    for (const auto& s : streams_.streams()) total_ += s.points.size();
-    return true;
   }
 
   const std::uint64_t run_;
@@ -188,7 +184,8 @@ class SceneSink final : public Component, public FieldListCodec<SceneRunResult> 
   recording::PortStreams<Point> streams_;
   std::vector<std::uint64_t> scans_;  // per stream: valid scans seen in the run
   SceneRunResult rec_;                // the run's stride and count (its streams: streams_)
-  std::size_t total_ = 0;
+  std::size_t total_ = 0;      // points kept
+  std::size_t thinnable_ = 0;  // of them, clutter of scans after the first
   bool active_ = false;
   // Aggregating instance.
   SceneRunResult recorded_;

@@ -107,6 +107,16 @@ TEST_CASE("sink.scene counts what does not fit without clutter") {
   CHECK(test::metric(sum, "points_not_recorded") == 20.0);
 }
 
+TEST_CASE("sink.scene: clutter of the first scan only is not thinned") {
+  auto s = make("{ max_points: 100 }");
+  test::start_run(*s, 0);
+  scan(*s, 0, 50);                           // 53 points, the clutter of scan 0 kept at any stride
+  for (int k = 1; k < 40; ++k) scan(*s, k, 0);  // 3 a scan: 47 more fit, 70 do not
+  const Summary sum = test::finish_run(*s);
+  CHECK(test::metric(sum, "points_not_recorded") == 70.0);
+  CHECK(test::metric(sum, "clutter_scan_stride") == 1.0);
+}
+
 TEST_CASE("sink.scene: the run result survives the codec") {
   test::check_codec_round_trip([] { return make("{}"); }, [](Component& s, int) {
     for (int k = 0; k < 3; ++k) scan(s, k, 2);
