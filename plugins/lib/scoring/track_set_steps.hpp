@@ -35,9 +35,11 @@ struct TrackSetCounts {
   std::uint64_t unscored_truth_steps = 0;  // truth batches with no TrackSet at their time
   std::uint64_t steps_without_truth = 0;   // TrackSets with no truth at their time (scored against none)
   std::uint64_t before_window = 0;         // TrackSets left out by skip_initial
+  std::uint64_t ids_out_of_range = 0;      // truths and tracks left out by TrackSetSteps::refuse_ids_from
   template <class Self, class F>
   static void fields(Self& r, F&& f) {
-    f(r.non_finite_tracks, r.non_finite_truths, r.unscored_truth_steps, r.steps_without_truth, r.before_window);
+    f(r.non_finite_tracks, r.non_finite_truths, r.unscored_truth_steps, r.steps_without_truth, r.before_window,
+      r.ids_out_of_range);
   }
   void add(const TrackSetCounts& o) {
     non_finite_tracks += o.non_finite_tracks;
@@ -45,24 +47,30 @@ struct TrackSetCounts {
     unscored_truth_steps += o.unscored_truth_steps;
     steps_without_truth += o.steps_without_truth;
     before_window += o.before_window;
+    ids_out_of_range += o.ids_out_of_range;
   }
 };
 
 // Streams: truths of one time are kept until the next time's; each TrackSet is paired on arrival
 // with the truths of exactly its time stamp (they arrive first, in time order). Reads the
-// parameters of track_set_params(). Buffers keep their capacity between scans and runs.
+// parameters of track_set_params(). Buffers keep their capacity between scans and runs. Each
+// kept truth and track has its id (truth target, track id) at the same index as its position.
 class TrackSetSteps {
  public:
   explicit TrackSetSteps(const Params& p)
       : statuses_(parse_track_statuses(p)), planar_(planar_dimensions(p)), skip_initial_(p.real("skip_initial")) {}
 
   bool planar() const { return planar_; }
+  // Truths and tracks with an id of `limit` or more are left out and counted (a sink that indexes
+  // tables by id keeps them bounded); checked after finiteness.
+  void refuse_ids_from(std::uint64_t limit) { id_limit_ = limit; }
   const TrackSetCounts& counts() const { return counts_; }
 
   void start_run() {
     counts_ = TrackSetCounts{};
     truth3_.clear();
     truth2_.clear();
+    truth_ids_.clear();
     have_batch_ = batch_used_ = false;
     first_set_ = std::numeric_limits<double>::quiet_NaN();
   }
@@ -75,11 +83,17 @@ class TrackSetSteps {
       batch_time_ = t.time;
       truth3_.clear();
       truth2_.clear();
+      truth_ids_.clear();
     }
     if (!t.position.allFinite()) {
       ++counts_.non_finite_truths;
       return;
     }
+    if (t.target >= id_limit_) {
+      ++counts_.ids_out_of_range;
+      return;
+    }
+    truth_ids_.push_back(t.target);
     truth3_.push_back(t.position);
     truth2_.push_back(t.position.head<2>());
   }
@@ -95,6 +109,7 @@ class TrackSetSteps {
     }
     track3_.clear();
     track2_.clear();
+    track_ids_.clear();
     for (const TrackEstimate& te : set.tracks) {
       if (!status_selected(statuses_, te.status) || !te.estimate.initialised) continue;
       const Vec3 pos = te.estimate.enu.head<3>();
@@ -102,6 +117,11 @@ class TrackSetSteps {
         ++counts_.non_finite_tracks;
         continue;
       }
+      if (te.id >= id_limit_) {
+        ++counts_.ids_out_of_range;
+        continue;
+      }
+      track_ids_.push_back(te.id);
       track3_.push_back(pos);
       track2_.push_back(pos.head<2>());
     }
@@ -109,6 +129,7 @@ class TrackSetSteps {
       ++counts_.steps_without_truth;
       truth3_.clear();
       truth2_.clear();
+      truth_ids_.clear();
     }
     return true;
   }
@@ -121,6 +142,8 @@ class TrackSetSteps {
 
   std::size_t truths() const { return truth3_.size(); }
   std::size_t tracks() const { return track3_.size(); }
+  std::span<const std::uint64_t> truth_ids() const { return truth_ids_; }
+  std::span<const std::uint64_t> track_ids() const { return track_ids_; }
 
   // f(truth positions, track positions) as spans of Eigen::Vector2d or Eigen::Vector3d, as dimensions asks.
   template <class F>
@@ -140,6 +163,8 @@ class TrackSetSteps {
   TrackSetCounts counts_;
   std::vector<Eigen::Vector3d> truth3_, track3_;
   std::vector<Eigen::Vector2d> truth2_, track2_;
+  std::vector<std::uint64_t> truth_ids_, track_ids_;
+  std::uint64_t id_limit_ = std::numeric_limits<std::uint64_t>::max();
   bool have_batch_ = false, batch_used_ = false;
   double batch_time_ = 0.0, first_set_ = 0.0;
 };
