@@ -324,6 +324,24 @@ class TrackSetScores {
   }
 
   const RunMeans<N>& means() const { return means_; }
+  // The run means as metrics names[i] (unit units[i]) for the i where keep(i), the first followed
+  // by its 95 % interval (<names[0]>_ci95_lo, _hi, in its unit; two runs or more). None without a
+  // scored run.
+  template <class Keep>
+  void publish_means(Summary& s, const std::array<const char*, N>& names, const std::array<std::string, N>& units,
+                     Keep keep) const {
+    if (!means_.runs()) return;
+    for (int i = 0; i < N; ++i) {
+      if (!keep(i)) continue;
+      const double mean = means_.mean(i);
+      s.metric(names[static_cast<std::size_t>(i)], mean, units[static_cast<std::size_t>(i)]);
+      if (i == 0 && means_.runs() >= 2) {
+        const double half = means_.ci95_half(0);
+        s.metric(std::string(names[0]) + "_ci95_lo", mean - half, units[0]);
+        s.metric(std::string(names[0]) + "_ci95_hi", mean + half, units[0]);
+      }
+    }
+  }
   // The per-step means, when `series` and any step was scored.
   const StepMeans<N>* by_time() const { return series_ && !by_time_.empty() ? &by_time_ : nullptr; }
   // The counters as metrics and the note on non-finite positions (publish_counts, note_non_finite).

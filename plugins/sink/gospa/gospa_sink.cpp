@@ -50,18 +50,9 @@ class GospaSink final : public Component, public FieldListCodec<scoring::StepRun
   void finish(Summary& s, const FinishContext&) override {
     const bool parts = gospa_.alpha() == 2.0;
     const std::array<std::string, kValues> units = this->units();
-    const auto& means = scores_.means();
-    for (int i = 0; i < kValues; ++i) {
-      if (!parts && i >= 3 && i <= 5) continue;
-      if (!means.runs()) break;
-      const double mean = means.mean(i);
-      s.metric(kNames[static_cast<std::size_t>(i)], mean, units[static_cast<std::size_t>(i)]);
-      if (i == 0 && means.runs() >= 2) {
-        const double half = means.ci95_half(i);
-        s.metric("gospa_ci95_lo", mean - half, "m");
-        s.metric("gospa_ci95_hi", mean + half, "m");
-      }
-    }
+    // Without alpha = 2 there is no decomposition: its three metrics and columns are left out, not NaN.
+    const auto has = [parts](int i) { return parts || i < 3 || i > 5; };
+    scores_.publish_means(s, kNames, units, has);
     scores_.publish_counts(s);
     s.notes.push_back(
         "GOSPA (c = " + number_text::general(gospa_.cutoff(), 6) + " m, p = " + number_text::general(gospa_.order(), 6) +
@@ -70,13 +61,12 @@ class GospaSink final : public Component, public FieldListCodec<scoring::StepRun
         (parts ? ", = gospa_localisation + gospa_missed + gospa_false (means of the p-th-power parts)" : "") +
         "; missed_targets / false_tracks: per step, truths / tracks without a partner closer than c");
     scores_.note_non_finite(s);
-    // Without alpha = 2 there is no decomposition: its three columns are left out, not filled with NaN.
     if (const auto* by_time = scores_.by_time())
       s.series.push_back(by_time->series(
           "gospa",
           "per time step, means over the runs with a track set at that step: GOSPA, its p-th power and "
           "parts (alpha = 2), OSPA, truths, tracks, missed targets, false tracks",
-          kNames, units, [parts](int i) { return parts || i < 3 || i > 5; }));
+          kNames, units, has));
   }
 
  private:

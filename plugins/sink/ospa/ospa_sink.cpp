@@ -46,15 +46,8 @@ class OspaSink final : public Component, public FieldListCodec<scoring::StepRunR
   void finish(Summary& s, const FinishContext&) override {
     const std::string unit_p = scoring::pow_p_unit(ospa_.order());
     const std::array<std::string, kValues> units = {"m", unit_p, unit_p, unit_p, "", ""};
-    const auto& means = scores_.means();
-    for (int i = 0; i < kValues && means.runs(); ++i) {
-      s.metric(kNames[static_cast<std::size_t>(i)], means.mean(i), units[static_cast<std::size_t>(i)]);
-      if (i == 0 && means.runs() >= 2) {
-        const double half = means.ci95_half(0);
-        s.metric("ospa_ci95_lo", means.mean(0) - half, "m");
-        s.metric("ospa_ci95_hi", means.mean(0) + half, "m");
-      }
-    }
+    const auto all = [](int) { return true; };
+    scores_.publish_means(s, kNames, units, all);
     scores_.publish_counts(s);
     s.notes.push_back("OSPA (c = " + number_text::general(ospa_.cutoff(), 6) + " m, p = " +
                       number_text::general(ospa_.order(), 6) +
@@ -66,7 +59,7 @@ class OspaSink final : public Component, public FieldListCodec<scoring::StepRunR
       s.series.push_back(by_time->series("ospa",
                                          "per time step, means over the runs with a track set at that step: OSPA, "
                                          "its p-th power and its localisation and cardinality terms, truths, tracks",
-                                         kNames, units, [](int) { return true; }));
+                                         kNames, units, all));
   }
 
  private:
