@@ -70,7 +70,7 @@ TEST_CASE("the inlined chart library is the vendored Vega and Vega-Lite") {
   CHECK(vega_lite_js().find("sourceMappingURL") == std::string_view::npos);
 }
 
-TEST_CASE("scene picture: lines per truth and track, every detection drawn") {
+TEST_CASE("scene picture: truth and track lines, all detections") {
   SceneView v;
   v.clutter.label = "clutter";
   v.target_detections.label = "target detections";
