@@ -1,4 +1,5 @@
-// Purpose: unit tests of the report library: CSV quoting and unit-carrying headers, series files, pipeline layout, page assets.
+// Purpose: unit tests of the report library: CSV quoting and unit-carrying headers, series files, pipeline layout, page assets, the multi-target scene picture.
+#include "charts.hpp"
 #include "csv_text.hpp"
 #include "report_assets.hpp"
 #include "series_csv.hpp"
@@ -67,4 +68,45 @@ TEST_CASE("the inlined chart library is the vendored Vega and Vega-Lite") {
   CHECK(vega_js().find("</script") == std::string_view::npos);
   CHECK(vega_lite_js().find("</script") == std::string_view::npos);
   CHECK(vega_lite_js().find("sourceMappingURL") == std::string_view::npos);
+}
+
+TEST_CASE("scene picture: truth and track lines, all detections") {
+  SceneView v;
+  v.clutter.label = "clutter";
+  v.target_detections.label = "target detections";
+  for (int k = 0; k < 3000; ++k) {  // more than a line's 1500 points: the recorder caps, the page does not thin
+    v.clutter.x.push_back(k);
+    v.clutter.y.push_back(-k);
+  }
+  v.target_detections.x = {0, 1};
+  v.target_detections.y = {0, 1};
+  v.truths.push_back(Line{"truth 0", {0, 1, 2}, {0, 0, 0}});
+  TrackPath t;
+  t.id = 12;
+  t.tentative = Line{"", {0, 1}, {1, 1}};
+  t.confirmed = Line{"", {1, 2, 3}, {1, 1, 1}};
+  v.tracks.push_back(t);
+  TrackPath never;  // a track that stayed tentative: no confirmed line
+  never.id = 13;
+  never.tentative = Line{"", {5, 6}, {5, 6}};
+  v.tracks.push_back(never);
+  const Chart c = scene_chart("scene", v);
+  auto attr = [&](const std::string& name) {
+    for (const auto& [n, value] : c.attributes)
+      if (n == name) return value;
+    return std::string("missing");
+  };
+  CHECK(attr("data-truth-lines") == "1");
+  CHECK(attr("data-track-lines") == "1");
+  CHECK(attr("data-clutter-points") == "3000");
+  CHECK(attr("data-target-detections") == "2");
+  CHECK(c.lines == 4);  // the truth, 12's tentative and confirmed parts, 13's tentative part
+  CHECK(c.symbols == 3002);
+  CHECK(c.caption == "equal scales on both axes");
+}
+
+TEST_CASE("scene picture: a track's colour depends on its id only") {
+  CHECK(std::string(track_colour(3)) == track_colour(13));
+  CHECK(std::string(track_colour(3)) != track_colour(4));
+  CHECK(std::string(track_colour(0)) == "#1f77b4");
 }

@@ -71,10 +71,10 @@ struct Loaded {
   Graph graph;
 };
 
-// `track_run` >= 0: also record that run's items for the report (a sink.track node is added;
-// its id goes to `track_node`).
+// `track_run` >= 0: also record that run's items for the report (a sink.track node and, for a
+// pipeline with a tracker, a sink.scene node are added; their ids go to `track_node`, `scene_node`).
 Loaded load_pipeline(const std::string& file, const std::vector<std::string>& sets, const Common& c,
-                     long long track_run = -1, std::string* track_node = nullptr) {
+                     long long track_run = -1, std::string* track_node = nullptr, std::string* scene_node = nullptr) {
   std::vector<Override> overrides;
   for (const auto& s : sets) overrides.push_back(parse_override(s));
   apply_trust(c);
@@ -85,6 +85,8 @@ Loaded load_pipeline(const std::string& file, const std::vector<std::string>& se
   warn_problems(l.reg);
   if (track_run >= 0 && track_node && l.reg.find("sink.track"))
     *track_node = add_track_recorder(l.cfg, l.reg, static_cast<std::uint64_t>(track_run));
+  if (track_run >= 0 && scene_node && l.reg.find("sink.scene"))
+    *scene_node = add_scene_recorder(l.cfg, l.reg, static_cast<std::uint64_t>(track_run));
   l.graph = build_graph(l.cfg, l.reg);
   return l;
 }
@@ -135,12 +137,12 @@ int cmd_run(int argc, char** argv, bool report_mode = false) {
   unsigned threads = static_cast<unsigned>(parse_count(threads_text, "--threads", 0, kMaxThreads));
   const std::uint64_t track_run = parse_count(track_run_text, "--track-run", 0, max64);
   const bool want_report = report_mode || !report_html.empty();
-  std::string track_node;
+  std::string track_node, scene_node;
   Loaded l;
   agreed_setup([&] {
     l = load_pipeline(file, sets, c,
                       want_report ? static_cast<long long>(std::min<std::uint64_t>(track_run, 1ull << 62)) : -1,
-                      &track_node);
+                      &track_node, &scene_node);
   });
   RunOptions ro;
   ro.runs = runs_given ? runs : l.graph.config.runs;
@@ -176,6 +178,7 @@ int cmd_run(int argc, char** argv, bool report_mode = false) {
   if (want_report)
     req.html = report_html.empty() ? (std::filesystem::path(ro.output_dir) / "report.html").string() : report_html;
   req.track_node = track_node;
+  req.scene_node = scene_node;
   req.track_run = track_run;
   req.command = command_line(argc, argv);
   const auto written = write_report_outputs(req, l.graph, out, results, static_cast<unsigned>(std::min<std::uint64_t>(ro.threads, ro.runs)));

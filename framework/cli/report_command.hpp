@@ -1,4 +1,4 @@
-// Purpose: what `trackflow run --series/--report` and `trackflow report` add to a run: the track recorder node and the report files.
+// Purpose: what `trackflow run --series/--report` and `trackflow report` add to a run: the track and scene recorder nodes and the report files.
 #pragma once
 
 #include <trackflow/host/config.hpp>
@@ -17,10 +17,16 @@ namespace trackflow::cli {
 // from their own ids, and the recorder is the last consumer of every stream.
 std::string add_track_recorder(host::PipelineConfig& cfg, const host::PluginRegistry& reg, std::uint64_t run);
 
+// For a pipeline with a tracker (a node producing track sets): appends a sink.scene node recording
+// run `run` of every node that produces truth, scans or track sets, for the report's picture;
+// returns its id, "" for a pipeline without a tracker. As harmless as the track recorder.
+std::string add_scene_recorder(host::PipelineConfig& cfg, const host::PluginRegistry& reg, std::uint64_t run);
+
 struct ReportRequest {
   std::string series_dir;  // write every node's series as CSV here ("" no)
   std::string html;        // write the HTML report here ("" no)
   std::string track_node;  // the recorder added by add_track_recorder ("" none)
+  std::string scene_node;  // the recorder added by add_scene_recorder ("" none)
   std::uint64_t track_run = 0;
   std::string command;     // the command line, shown in the report
 };

@@ -14,7 +14,9 @@ namespace {
 
 constexpr int kWidth = 860, kHeight = 260;
 
-size_t stride_for(size_t n) { return n <= kMaxPointsPerLine ? 1 : (n + kMaxPointsPerLine - 1) / kMaxPointsPerLine; }
+size_t stride_for(size_t n, size_t max_points = kMaxPointsPerLine) {
+  return n <= max_points ? 1 : (n + max_points - 1) / max_points;
+}
 
 json base_spec(const std::string& title) {
   return {{"$schema", "https://vega.github.io/schema/vega-lite/v6.json"},
@@ -24,10 +26,12 @@ json base_spec(const std::string& title) {
           {"config", {{"font", "sans-serif"}, {"legend", {{"orient", "top"}, {"labelLimit", 320}}}}}};
 }
 
-// Appends the finite points of `line` to `values` as {x, y, s[, o]}; returns how many.
-long append_points(json& values, const Line& line, const std::vector<double>* order = nullptr) {
+// Appends the finite points of `line` to `values` as {x, y, s[, o]}, thinned to at most
+// `max_points`; returns how many.
+long append_points(json& values, const Line& line, const std::vector<double>* order = nullptr,
+                   size_t max_points = kMaxPointsPerLine) {
   long n = 0;
-  const size_t step = stride_for(line.x.size());
+  const size_t step = stride_for(line.x.size(), max_points);
   for (size_t i = 0; i < line.x.size() && i < line.y.size(); i += step) {
     if (!std::isfinite(line.x[i]) || !std::isfinite(line.y[i])) continue;
     json p = {{"x", round6(line.x[i])}, {"y", round6(line.y[i])}, {"s", line.label}};
@@ -53,6 +57,45 @@ bool all_positive(const std::vector<Line>& lines) {
         any = true;
       }
   return any;
+}
+
+// The x and y scales of a picture in a plane, and its height. With `equal_axes`: the same metres
+// per pixel on both axes, so the geometry is not distorted -- unless the points are much longer
+// than wide (a straight approach would be a flat line), when each axis gets its own scale; the
+// caption says which.
+struct PlaneScales {
+  json x = {{"zero", false}}, y = {{"zero", false}};
+  int height = kHeight;
+  std::string caption;
+};
+
+PlaneScales plane_scales(const std::vector<const Line*>& lines, bool equal_axes) {
+  PlaneScales s;
+  if (!equal_axes) return s;
+  const int width = kWidth;
+  s.height = 420;
+  double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
+  for (const Line* l : lines)
+    for (size_t i = 0; i < l->x.size() && i < l->y.size(); ++i)
+      if (std::isfinite(l->x[i]) && std::isfinite(l->y[i])) {
+        x0 = std::min(x0, l->x[i]);
+        x1 = std::max(x1, l->x[i]);
+        y0 = std::min(y0, l->y[i]);
+        y1 = std::max(y1, l->y[i]);
+      }
+  const double sx = std::max(x1 - x0, 1.0), sy = std::max(y1 - y0, 1.0);
+  if (std::isfinite(x0) && std::isfinite(y0) && std::max(sx / sy, sy / sx) > 8.0) {
+    s.caption = "axes scaled independently (the track is " + std::to_string(static_cast<long>(std::max(sx, sy))) +
+                " m long and " + std::to_string(static_cast<long>(std::min(sx, sy))) + " m wide)";
+    s.height = kHeight + 60;
+  } else if (std::isfinite(x0) && std::isfinite(y0)) {
+    s.caption = "equal scales on both axes";
+    const double per_px = std::max(sx / width, sy / s.height) * 1.05;
+    const double cx = 0.5 * (x0 + x1), cy = 0.5 * (y0 + y1);
+    s.x["domain"] = {round6(cx - per_px * width / 2), round6(cx + per_px * width / 2)};
+    s.y["domain"] = {round6(cy - per_px * s.height / 2), round6(cy + per_px * s.height / 2)};
+  }
+  return s;
 }
 
 }  // namespace
@@ -154,34 +197,13 @@ Chart track_chart(const std::string& title, const std::string& x_title, const st
   for (const auto& p : points) c.symbols += append_points(point_values, p);
   std::vector<Line> all = points;
   all.insert(all.end(), paths.begin(), paths.end());
-  json xscale = {{"zero", false}}, yscale = {{"zero", false}};
-  int width = kWidth, height = equal_axes ? 420 : kHeight;
-  if (equal_axes) {
-    // Same metres per pixel on both axes, so the geometry is not distorted.
-    double x0 = std::numeric_limits<double>::infinity(), x1 = -x0, y0 = x0, y1 = -x0;
-    for (const auto& l : all)
-      for (size_t i = 0; i < l.x.size() && i < l.y.size(); ++i)
-        if (std::isfinite(l.x[i]) && std::isfinite(l.y[i])) {
-          x0 = std::min(x0, l.x[i]);
-          x1 = std::max(x1, l.x[i]);
-          y0 = std::min(y0, l.y[i]);
-          y1 = std::max(y1, l.y[i]);
-        }
-    const double sx = std::max(x1 - x0, 1.0), sy = std::max(y1 - y0, 1.0);
-    // A track much longer than wide (a straight approach) would be a flat line at equal
-    // scales: then each axis gets its own scale, and the caption says so.
-    if (std::isfinite(x0) && std::isfinite(y0) && std::max(sx / sy, sy / sx) > 8.0) {
-      c.caption = "axes scaled independently (the track is " + std::to_string(static_cast<long>(std::max(sx, sy))) +
-                  " m long and " + std::to_string(static_cast<long>(std::min(sx, sy))) + " m wide)";
-      height = kHeight + 60;
-    } else if (std::isfinite(x0) && std::isfinite(y0)) {
-      c.caption = "equal scales on both axes";
-      const double per_px = std::max(sx / width, sy / height) * 1.05;
-      const double cx = 0.5 * (x0 + x1), cy = 0.5 * (y0 + y1);
-      xscale["domain"] = {round6(cx - per_px * width / 2), round6(cx + per_px * width / 2)};
-      yscale["domain"] = {round6(cy - per_px * height / 2), round6(cy + per_px * height / 2)};
-    }
-  }
+  std::vector<const Line*> drawn;
+  for (const auto& l : all) drawn.push_back(&l);
+  const PlaneScales scales = plane_scales(drawn, equal_axes);
+  const json& xscale = scales.x;
+  const json& yscale = scales.y;
+  const int width = kWidth, height = scales.height;
+  c.caption = scales.caption;
   json domain = labels(all);
   // Truth in black, measurements in pale colours, estimates in strong ones.
   const char* pale[] = {"#9ecae1", "#c7c7c7", "#fdd0a2", "#c7e9c0"};
@@ -210,6 +232,97 @@ Chart track_chart(const std::string& title, const std::string& x_title, const st
           {"y", {{"field", "y"}, {"type", "quantitative"}, {"scale", yscale}}},
           {"order", {{"field", "o"}}},
           {"color", color}}}}});
+  return c;
+}
+
+const char* track_colour(std::uint64_t id) {
+  static const char* palette[] = {"#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd",
+                                  "#8c564b", "#e377c2", "#17becf", "#bcbd22", "#7f7f7f"};
+  return palette[id % 10];
+}
+
+Chart scene_chart(const std::string& title, const SceneView& v) {
+  Chart c;
+  c.title = title;
+  json points = json::array(), truths = json::array(), tentative = json::array(), confirmed = json::array();
+  // Each line's points carry its group "g" (drawn as one path), its sample index "o" (time order)
+  // and, for tracks, its colour "c".
+  auto add_line = [&](json& values, const Line& l, const std::string& group, const char* colour) {
+    json part = json::array();
+    std::vector<double> order(l.x.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = static_cast<double>(i);
+    const long n = append_points(part, l, &order);
+    for (auto& p : part) {
+      p["g"] = group;
+      if (colour) p["c"] = colour;
+      p.erase("s");
+      values.push_back(std::move(p));
+    }
+    if (n > 0) {
+      ++c.lines;
+      c.line_points += n;
+    }
+    return n > 0 ? 1 : 0;
+  };
+  int truth_lines = 0, track_lines = 0;
+  for (size_t k = 0; k < v.truths.size(); ++k) truth_lines += add_line(truths, v.truths[k], "t" + std::to_string(k), nullptr);
+  for (const auto& t : v.tracks) {
+    const char* colour = track_colour(t.id);
+    add_line(tentative, t.tentative, std::to_string(t.id) + "t", colour);
+    track_lines += add_line(confirmed, t.confirmed, std::to_string(t.id), colour);
+  }
+  const size_t all_points = std::numeric_limits<size_t>::max();
+  const long clutter = append_points(points, v.clutter, nullptr, all_points);
+  const long detections = append_points(points, v.target_detections, nullptr, all_points);
+  c.symbols = clutter + detections;
+  c.attributes = {{"data-truth-lines", std::to_string(truth_lines)},
+                  {"data-track-lines", std::to_string(track_lines)},
+                  {"data-clutter-points", std::to_string(clutter)},
+                  {"data-target-detections", std::to_string(detections)}};
+  std::vector<const Line*> drawn = {&v.clutter, &v.target_detections};
+  for (const auto& l : v.truths) drawn.push_back(&l);
+  for (const auto& t : v.tracks) {
+    drawn.push_back(&t.confirmed);
+    drawn.push_back(&t.tentative);
+  }
+  const PlaneScales scales = plane_scales(drawn, true);
+  c.caption = scales.caption;
+  auto xy = [&](bool titled) {
+    json x = {{"field", "x"}, {"type", "quantitative"}, {"scale", scales.x}};
+    json y = {{"field", "y"}, {"type", "quantitative"}, {"scale", scales.y}};
+    if (titled) {
+      x["title"] = "east x [m]";
+      y["title"] = "north y [m]";
+    }
+    return std::make_pair(x, y);
+  };
+  auto line_layer = [&](const json& values, json mark, bool coloured) {
+    const auto [x, y] = xy(false);
+    json enc = {{"x", x}, {"y", y}, {"detail", {{"field", "g"}, {"type", "nominal"}}}, {"order", {{"field", "o"}}}};
+    if (coloured) enc["color"] = {{"field", "c"}, {"type", "nominal"}, {"scale", nullptr}, {"legend", nullptr}};
+    mark["type"] = "line";
+    mark["clip"] = true;
+    return json{{"data", {{"values", values}}}, {"mark", mark}, {"encoding", enc}};
+  };
+  const auto [x, y] = xy(true);
+  json layers = json::array(
+      {{{"data", {{"values", points}}},
+        {"mark", {{"type", "point"}, {"filled", true}, {"size", 8}, {"opacity", 0.6}, {"clip", true}}},
+        {"params", json::array({{{"name", "zoom"}, {"select", "interval"}, {"bind", "scales"}}})},
+        {"encoding",
+         {{"x", x},
+          {"y", y},
+          {"color",
+           {{"field", "s"}, {"type", "nominal"}, {"title", nullptr},
+            {"scale", {{"domain", {v.clutter.label, v.target_detections.label}}, {"range", {"#c7c7c7", "#555555"}}}}}}}}},
+       line_layer(truths, {{"color", "#000000"}, {"strokeWidth", 1.2}, {"strokeDash", {4, 3}}}, false),
+       line_layer(tentative, {{"strokeWidth", 1.2}, {"opacity", 0.3}}, true),
+       line_layer(confirmed, {{"strokeWidth", 1.8}}, true)});
+  c.spec = base_spec(title);
+  c.spec["height"] = scales.height;
+  c.spec["layer"] = std::move(layers);
+  // The tracks' literal colours must not share a scale with the detections' legend.
+  c.spec["resolve"] = {{"scale", {{"color", "independent"}}}};
   return c;
 }
 

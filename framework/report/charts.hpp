@@ -3,7 +3,9 @@
 
 #include <nlohmann/json.hpp>
 
+#include <cstdint>
 #include <string>
+#include <utility>
 #include <vector>
 
 namespace trackflow::report {
@@ -26,6 +28,7 @@ struct Chart {
   long line_points = 0;
   int areas = 0;
   long symbols = 0;
+  std::vector<std::pair<std::string, std::string>> attributes;  // more data-* attributes of its element
 };
 
 // Series longer than this are thinned to every k-th point (the CSV keeps them all).
@@ -43,6 +46,25 @@ Chart band_chart(const std::string& title, const std::string& y_title, const Lin
 // time order, `points` as small symbols (measurements); equal axis scales when `equal_axes`.
 Chart track_chart(const std::string& title, const std::string& x_title, const std::string& y_title,
                   const std::vector<Line>& paths, const std::vector<Line>& points, bool equal_axes);
+
+// The multi-target picture of one run in the x-y plane, at equal scales: each truth a black
+// dashed line, each track a line in its own colour (track_colour of its id; its tentative
+// positions pale), and the scan detections as dots, clutter grey and target-originated dark.
+// Detections are drawn all (the recorder caps them), lines thinned as line_chart's.
+struct TrackPath {
+  std::uint64_t id = 0;
+  Line confirmed;  // confirmed and coasting positions, in time order
+  Line tentative;
+};
+struct SceneView {
+  std::vector<Line> truths;  // one per target
+  std::vector<TrackPath> tracks;
+  Line clutter, target_detections;
+};
+Chart scene_chart(const std::string& title, const SceneView& v);
+
+// A track's colour from a fixed palette of 10 by its id, the same in every report.
+const char* track_colour(std::uint64_t id);
 
 // The pipeline drawn as boxes and arrows; nodes as {id, type, kind, column, row}, edges as
 // index pairs (dashed: an adapter's attachment).

@@ -137,7 +137,9 @@ class Page {
     const std::string id = "chart-" + std::to_string(charts_.size());
     body_ += "<div class=\"chart\" id=\"" + id + "\" data-title=\"" + esc(c.title) + "\" data-lines=\"" +
              std::to_string(c.lines) + "\" data-line-points=\"" + std::to_string(c.line_points) + "\" data-areas=\"" +
-             std::to_string(c.areas) + "\" data-symbols=\"" + std::to_string(c.symbols) + "\"></div>\n";
+             std::to_string(c.areas) + "\" data-symbols=\"" + std::to_string(c.symbols) + "\"";
+    for (const auto& [name, value] : c.attributes) body_ += " " + name + "=\"" + esc(value) + "\"";
+    body_ += "></div>\n";
     if (!c.caption.empty()) body_ += "<div class=\"caption\">" + esc(c.caption) + "</div>\n";
     json spec = c.spec;
     compact_data(spec);
@@ -223,13 +225,16 @@ std::string header_html(const host::PipelineConfig& c, const std::string& kind, 
   return h;
 }
 
-void pipeline_section(Page& page, const host::Graph& g, const std::string& hidden) {
+// The recorders the report adds: drawn from, not shown as the analyst's nodes.
+using Hidden = std::set<std::string>;
+
+void pipeline_section(Page& page, const host::Graph& g, const Hidden& hidden) {
   page.html("<h2>Pipeline</h2>\n");
   std::vector<GraphNodeView> nodes;
   std::vector<int> view_index(g.nodes.size(), -1);
   const auto pos = layout_pipeline(g);
   for (size_t i = 0; i < g.nodes.size(); ++i) {
-    if (g.nodes[i].config.id == hidden) continue;
+    if (hidden.count(g.nodes[i].config.id)) continue;
     view_index[i] = static_cast<int>(nodes.size());
     nodes.push_back({g.nodes[i].config.id, g.nodes[i].config.type, to_string(g.nodes[i].type->decl.kind), pos[i].column,
                      pos[i].row});
@@ -244,7 +249,7 @@ void pipeline_section(Page& page, const host::Graph& g, const std::string& hidde
   page.chart(graph_chart(nodes, edges));
   page.html("<table><tr><th>node</th><th>type</th><th>kind</th><th>inputs</th><th>parameters (as written)</th></tr>\n");
   for (const auto& n : g.nodes) {
-    if (n.config.id == hidden) continue;
+    if (hidden.count(n.config.id)) continue;
     std::string inputs;
     for (size_t k = 0; k < n.config.inputs.size(); ++k) inputs += (k ? ", " : "") + n.config.inputs[k];
     if (!n.config.attach_to.empty()) inputs = "attached to " + n.config.attach_to;
@@ -257,7 +262,7 @@ void pipeline_section(Page& page, const host::Graph& g, const std::string& hidde
 }
 
 void summary_section(Page& page, const host::Outcome& out, const std::vector<host::ExpectResult>& expects,
-                     unsigned threads, std::uint64_t seed, const std::string& hidden) {
+                     unsigned threads, std::uint64_t seed, const Hidden& hidden) {
   page.html("<h2>Summary</h2>\n<p>" + std::to_string(out.runs) + (out.runs == 1 ? " run" : " runs") + ", seed " +
             std::to_string(seed) + ", " + std::to_string(threads) + (threads == 1 ? " thread" : " threads") + ", " +
             num(out.seconds) + " s" +
@@ -267,7 +272,7 @@ void summary_section(Page& page, const host::Outcome& out, const std::vector<hos
                              : std::string()) +
             ".</p>\n");
   for (const auto& n : out.nodes) {
-    if (n.id == hidden) continue;
+    if (hidden.count(n.id)) continue;
     if (n.summary.metrics.empty() && n.summary.notes.empty() && n.skips == 0) continue;
     page.html("<h3>" + esc(n.id) + " <small>(" + esc(n.type) + ")</small></h3>\n");
     if (!n.summary.metrics.empty()) {
@@ -472,6 +477,78 @@ void track_section(Page& page, const host::Graph& g, const host::Outcome& out, c
   page.chart(track_chart("altitude against time", "time [s]", "up z [m]", alt_paths, alt_points, false));
 }
 
+// sink.scene's series as lines: truths by target, tracks by id split into confirmed / tentative,
+// detections split into clutter / target-originated.
+SceneView scene_view(const host::NodeOutcome& scene, const Series& tracks) {
+  SceneView v;
+  v.clutter.label = "clutter";
+  v.target_detections.label = "target detections";
+  std::map<double, size_t> truth_of;
+  std::map<double, size_t> track_of;
+  bool unknown = false;
+  for (const auto& s : scene.summary.series) {
+    const int cx = s.column("x"), cy = s.column("y");
+    if (cx < 0 || cy < 0) continue;
+    const bool truth = s.name.rfind("truth:", 0) == 0, scan = s.name.rfind("scan:", 0) == 0;
+    for (size_t r = 0; truth && r < s.rows(); ++r) {
+      const double id = s.at(r, static_cast<size_t>(s.column("target")));
+      auto [it, fresh] = truth_of.try_emplace(id, v.truths.size());
+      if (fresh) v.truths.emplace_back().label = "truth " + num(id);
+      v.truths[it->second].x.push_back(s.at(r, static_cast<size_t>(cx)));
+      v.truths[it->second].y.push_back(s.at(r, static_cast<size_t>(cy)));
+    }
+    for (size_t r = 0; scan && r < s.rows(); ++r) {
+      const double origin = s.at(r, static_cast<size_t>(s.column("origin")));
+      unknown |= origin == -2.0;
+      Line& l = origin >= 0.0 ? v.target_detections : v.clutter;
+      l.x.push_back(s.at(r, static_cast<size_t>(cx)));
+      l.y.push_back(s.at(r, static_cast<size_t>(cy)));
+    }
+  }
+  if (unknown) v.clutter.label = "clutter or unknown origin";
+  const int cx = tracks.column("x"), cy = tracks.column("y"), ct = tracks.column("track"), cs = tracks.column("status");
+  if (cx < 0 || cy < 0 || ct < 0 || cs < 0) return v;
+  for (size_t r = 0; r < tracks.rows(); ++r) {
+    const double id = tracks.at(r, static_cast<size_t>(ct));
+    auto [it, fresh] = track_of.try_emplace(id, v.tracks.size());
+    if (fresh) v.tracks.emplace_back().id = static_cast<std::uint64_t>(id);
+    TrackPath& t = v.tracks[it->second];
+    Line& l = tracks.at(r, static_cast<size_t>(cs)) == 0.0 ? t.tentative : t.confirmed;
+    l.x.push_back(tracks.at(r, static_cast<size_t>(cx)));
+    l.y.push_back(tracks.at(r, static_cast<size_t>(cy)));
+  }
+  return v;
+}
+
+// The multi-target picture of one run per tracker: truth, its tracks coloured by id, the scans' detections.
+void scene_section(Page& page, const host::Outcome& out, const std::string& scene_node, std::uint64_t run) {
+  const host::NodeOutcome* scene = out.find(scene_node);
+  if (!scene) return;
+  const Metric* stride = scene->summary.find("clutter_scan_stride");
+  const Metric* lost = scene->summary.find("points_not_recorded");
+  std::string recorded = "every detection of every scan";
+  if (stride && stride->value > 1.0)
+    recorded = "target detections of every scan, clutter of every " + num(stride->value) +
+               "th scan only (the recorder's cap, sink.scene max_points, default 200 000 points)";
+  if (lost && lost->value > 0.0) recorded += "; " + num(lost->value) + " points past that cap were not recorded";
+  bool header = false;
+  for (const auto& s : scene->summary.series) {
+    if (s.name.rfind("tracks:", 0) != 0) continue;
+    if (!header) {
+      page.html("<h2>Scene of run " + std::to_string(run) + "</h2>\n<p class=\"note\">Truth, tracks and clutter per "
+                "scan in the radar's plane (east-north, ENU) for one run (<code>--track-run</code>): each target's "
+                "truth black and dashed, each track in its own colour by track id (a fixed palette of 10: colour = id "
+                "mod 10; pale while tentative), the scans' detections as dots, clutter grey and target-originated "
+                "dark.</p>\n");
+      header = true;
+    }
+    const std::string tracker = s.name.substr(7);
+    Chart c = scene_chart("scene of run " + std::to_string(run) + " - " + tracker, scene_view(*scene, s));
+    c.caption += (c.caption.empty() ? "" : "; ") + std::string("drawn: ") + recorded;
+    page.chart(c);
+  }
+}
+
 // Series of per-interval RMSE (sink.interval_rmse): the filter against the measurements.
 // sink.gospa's series: GOSPA of every scored tracker against time, then each one's parts (alpha = 2).
 void gospa_section(Page& page, const host::Outcome& out) {
@@ -529,14 +606,16 @@ std::string render_run_report(const RunReport& r) {
   const host::Outcome& out = *r.outcome;
   Page page;
   page.html(header_html(g.config, "run report", r.command));
-  pipeline_section(page, g, r.track_node);
+  const Hidden hidden = {r.track_node, r.scene_node};
+  pipeline_section(page, g, hidden);
   static const std::vector<host::ExpectResult> none;
-  summary_section(page, out, r.expects ? *r.expects : none, r.threads, g.config.seed, r.track_node);
+  summary_section(page, out, r.expects ? *r.expects : none, r.threads, g.config.seed, hidden);
   const auto scored = scored_series(g, out);
   error_section(page, scored);
   consistency_section(page, scored);
   gospa_section(page, out);
   if (!r.track_node.empty()) track_section(page, g, out, r.track_node, r.track_run);
+  if (!r.scene_node.empty()) scene_section(page, out, r.scene_node, r.track_run);
   annotation_section(page, scored);
   interval_section(page, g, out);
   files_section(page, r.files);
@@ -547,7 +626,7 @@ std::string render_sweep_report(const SweepReport& r) {
   const host::Graph& g = *r.graph;
   Page page;
   page.html(header_html(g.config, "sweep report", r.command));
-  pipeline_section(page, g, {});
+  pipeline_section(page, g, Hidden{});
   const size_t points = r.metrics.empty() ? 0 : r.metrics.front().value.size();
   page.html("<h2>Sweep</h2>\n<p>" + std::to_string(points) + " grid points, " + std::to_string(r.runs) +
             " runs each, the same seed at every point (common random numbers).</p>\n");

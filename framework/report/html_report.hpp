@@ -11,13 +11,14 @@
 namespace trackflow::report {
 
 struct RunReport {
-  const host::Graph* graph = nullptr;  // as run (with the track recorder, if any)
+  const host::Graph* graph = nullptr;  // as run (with the track and scene recorders, if any)
   const host::Outcome* outcome = nullptr;
   const std::vector<host::ExpectResult>* expects = nullptr;
   unsigned threads = 1;
   std::string command;                 // how the report was made, shown in its header
   std::string track_node;              // id of the sink.track node whose run is drawn ("" none)
-  std::uint64_t track_run = 0;
+  std::uint64_t track_run = 0;         // also the run of the scene drawn
+  std::string scene_node;              // id of the sink.scene node whose run is drawn ("" none)
   std::vector<std::string> files;      // files written next to it (series CSV)
 };
 

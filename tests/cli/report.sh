@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Purpose: `trackflow report`, `run --series` and the unit-carrying outputs: self-contained HTML under 5 MB, per-step series (ANEES in band, mean = summary), metrics JSON, sink.csv covariance, tables.
+# Purpose: `trackflow report`, `run --series` and the unit-carrying outputs: self-contained HTML under 5 MB, the multi-target scene picture, per-step series (ANEES in band, mean = summary), metrics JSON, sink.csv covariance, tables.
 set -u
 TF=$1
 PLUGINS=$2
@@ -22,6 +22,9 @@ for t in 'position RMSE against time' 'ANEES against time - cdkf' 'ANEES against
 done
 grep -q 'adaptive_r' "$H" || fail "the pipeline section lacks the adapter"
 grep -q '>pass<' "$H" || fail "the expect table is missing"
+# A single-target pipeline has no tracker: no scene recorder, no multi-target picture.
+grep -q 'data-title="scene of run' "$H" && fail "the single-target report draws a multi-target scene"
+ls "$TMP/rbs" | grep -q '^report_scene' && fail "the single-target report recorded a scene: $(ls "$TMP/rbs")"
 echo "ok: rbs_landing_scn3 report: one file of $size bytes, no external references, the plots and tables"
 checks=$((checks + 1))
 
@@ -109,5 +112,21 @@ grep -q 'measurements processed by 0 filters' "$TMP/mtt/report.html" && fail "th
 grep -q 'GOSPA against time' "$TMP/mtt/report.html" || fail "the multi-target report has no GOSPA chart"
 grep -q 'GOSPA parts (p-th power) against time - gospa_nn' "$TMP/mtt/report.html" || fail "no GOSPA parts chart per scoring node"
 checks=$((checks + 1)); echo "ok: report of a multi-target pipeline (GOSPA summaries, charts and series, no single-track plot)"
+
+# --- the multi-target picture: truth, tracks coloured by id and clutter per scan, per tracker ------
+M="$TMP/mtt/report.html"
+for tracker in gnn nn; do
+  div=$(grep -o "<div class=\"chart\"[^>]*data-title=\"scene of run 0 - $tracker\"[^>]*>" "$M") ||
+    fail "the multi-target report has no scene picture for $tracker"
+  attr() { grep -o "$1=\"[0-9]*\"" <<< "$div" | grep -o '[0-9]*'; }
+  [ "$(attr data-truth-lines)" -eq 6 ] || fail "scene of $tracker: $(attr data-truth-lines) truth lines, not 6: $div"
+  [ "$(attr data-track-lines)" -gt 0 ] || fail "scene of $tracker: no track polylines: $div"
+  [ "$(attr data-clutter-points)" -gt 0 ] || fail "scene of $tracker: no clutter drawn: $div"
+  [ "$(attr data-target-detections)" -gt 0 ] || fail "scene of $tracker: no target detections drawn: $div"
+  [ -s "$TMP/mtt/report_scene.tracks-$tracker.csv" ] || fail "no scene series CSV of $tracker's tracks"
+done
+grep -q 'drawn: every detection of every scan' "$M" || fail "the scene's caption does not say what was drawn"
+grep -q '<td><b>report_scene' "$M" && fail "the scene recorder shows in the pipeline table"
+checks=$((checks + 1)); echo "ok: multi-target report: a scene per tracker (6 truths, track polylines, clutter, target detections)"
 
 finish

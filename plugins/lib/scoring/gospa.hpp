@@ -32,6 +32,11 @@ struct GospaResult {
   double gospa = 0.0;        // d_p^(c, alpha)(X, Y)
   double gospa_pow_p = 0.0;  // the same before the 1/p root: what sums and averages over time
   double ospa = 0.0;         // d_p^(c)(X, Y) of Schuhmacher, Vo and Vo (0 for two empty sets)
+  // OSPA's p-th power in its two terms, both divided by n = max(|X|, |Y|) (0 for two empty sets):
+  // localisation (1/n) min_pi sum d^(c)^p and cardinality (1/n) c^p (n - m). Their sum is ospa^p
+  // up to rounding; the paper's components e_loc and e_card are their p-th roots.
+  double ospa_localisation = 0.0;
+  double ospa_cardinality = 0.0;
   std::optional<GospaDecomposition> decomposition;  // alpha == 2 only
   // Per truth: its track (a pair closer than c), or -1. Views the Gospa object's storage, valid
   // until its next evaluate() or reserve().
@@ -130,6 +135,10 @@ class Gospa {
     r.gospa_pow_p = assignment_cost + cutoff_pow_p_ / alpha_ * unmatched;
     r.gospa = root_p(r.gospa_pow_p);
     r.ospa = larger == 0 ? 0.0 : root_p((assignment_cost + cutoff_pow_p_ * unmatched) / larger);
+    if (larger) {
+      r.ospa_localisation = assignment_cost / larger;
+      r.ospa_cardinality = cutoff_pow_p_ * unmatched / larger;
+    }
 
     // Proposition 1: the pairs of gamma are those closer than c; every other truth is missed and
     // every other track false (c^p / 2 each: a clipped pair's c^p split in two).

@@ -6,64 +6,22 @@
 #include <catch2/catch.hpp>
 
 #include <cmath>
-#include <cstring>
 #include <string>
 #include <vector>
 
-#include "plugin_fixture.hpp"
+#include "scoring/track_set_fixture.hpp"
 
 using namespace trackflow;
 
+using test::metric;
+using test::one_run;
+using test::step;
+using test::track;
+using test::truth;
+
 namespace {
 
-TrackEstimate track(std::uint64_t id, Vec3 p, TrackStatus st = TrackStatus::Confirmed) {
-  TrackEstimate t;
-  t.id = id;
-  t.status = st;
-  t.estimate.initialised = true;
-  t.estimate.enu.setZero();
-  t.estimate.enu.head<3>() = p;
-  return t;
-}
-
-Truth truth(double time, std::uint32_t id, Vec3 p) {
-  Truth t;
-  t.time = time;
-  t.target = id;
-  t.position = p;
-  return t;
-}
-
-std::vector<InputInfo> inputs() {
-  return {{"tracker", "tracker.multi", mask(ItemKind::Tracks), {}}, {"scenario", "sim.scenario", mask(ItemKind::Truth), {}}};
-}
-
-std::shared_ptr<Component> make(const std::string& yaml) {
-  auto s = test::make("sink.gospa", yaml);
-  s->set_inputs(inputs());
-  return s;
-}
-
-// One step at t = 1 s: the truths, then the set.
-void step(Component& s, double time, const std::vector<Vec3>& truths, const std::vector<TrackEstimate>& tracks) {
-  for (std::size_t i = 0; i < truths.size(); ++i) s.on_truth(truth(time, static_cast<std::uint32_t>(i), truths[i]), 1);
-  s.on_tracks(TrackSet{time, tracks}, 0);
-}
-
-double metric(const Summary& s, const std::string& name) {
-  const Metric* m = s.find(name);
-  return m ? m->value : -1.0;
-}
-
-Summary one_run(Component& s, const std::vector<Vec3>& truths, const std::vector<TrackEstimate>& tracks) {
-  test::start_run(s);
-  step(s, 1.0, truths, tracks);
-  auto r = s.end_run();
-  s.merge(*r);
-  Summary sum;
-  s.finish(sum, {});
-  return sum;
-}
+std::shared_ptr<Component> make(const std::string& yaml) { return test::make_track_set_sink("sink.gospa", yaml); }
 
 }  // namespace
 
@@ -176,44 +134,13 @@ TEST_CASE("alpha other than 2: no parts, and no NaN in the series") {
 }
 
 TEST_CASE("the run result survives the codec") {
-  auto s = make("{ cutoff: 10 m }");
-  auto direct = make("{ cutoff: 10 m }");
-  auto decoded = make("{ cutoff: 10 m }");
-  const auto& codec = dynamic_cast<const RunResultCodec&>(*s);
-  for (int run = 0; run < 3; ++run) {
-    test::start_run(*s, run);
-    step(*s, 1.0, {Vec3(0, 0, 0), Vec3(20, 0, 0)}, {track(1, Vec3(run, 1, 0))});
-    auto r = s->end_run();
-    std::string bytes;
-    ByteWriter w(bytes);
-    codec.save_run_result(*r, w);
-    ByteReader in(bytes.data(), bytes.size());
-    auto back = dynamic_cast<const RunResultCodec&>(*decoded).load_run_result(in);
-    CHECK(in.done());
-    direct->merge(*r);
-    decoded->merge(*back);
-  }
-  Summary a, b;
-  direct->finish(a, {});
-  decoded->finish(b, {});
-  REQUIRE(a.metrics.size() == b.metrics.size());
-  for (std::size_t i = 0; i < a.metrics.size(); ++i) {
-    CHECK(a.metrics[i].name == b.metrics[i].name);
-    CHECK(std::memcmp(&a.metrics[i].value, &b.metrics[i].value, sizeof(double)) == 0);
-  }
-  CHECK(a.series[0].values == b.series[0].values);
+  test::check_codec_round_trip([] { return make("{ cutoff: 10 m }"); }, [](Component& s, int run) {
+    step(s, 1.0, {Vec3(0, 0, 0), Vec3(20, 0, 0)}, {track(1, Vec3(run, 1, 0))});
+  });
 }
 
 TEST_CASE("bad parameters are refused by name") {
-  auto refused = [](const std::string& yaml, const std::string& name) {
-    try {
-      test::make("sink.gospa", yaml);
-    } catch (const ConfigError& e) {
-      CHECK_THAT(std::string(e.what()), Catch::Contains(name));
-      return;
-    }
-    FAIL("accepted: " << yaml);
-  };
+  auto refused = [](const std::string& yaml, const std::string& name) { test::check_refused("sink.gospa", yaml, name); };
   refused("{ cutoff: 0 m }", "cutoff");
   refused("{ cutoff: 1 m, order: 0.5 }", "order");
   refused("{ cutoff: 1 m, alpha: 3 }", "alpha");

@@ -1,4 +1,6 @@
 // Purpose: sink.track — records the truth, measurements (in ENU) and estimates of one chosen run, for the report's track plots.
+#include "recording/port_streams.hpp"
+
 #include <trackflow/geometry.hpp>
 #include <trackflow/plugin.hpp>
 #include <trackflow/run_result_codec.hpp>
@@ -22,15 +24,8 @@ struct Point {
   double sigma[3];
 };
 
-// One recorded stream: an input port and one item kind.
-struct Stream {
-  ItemKind kind;
-  std::vector<Point> points;
-  template <class Self, class F>
-  static void fields(Self& s, F&& f) {
-    f(s.kind, s.points);
-  }
-};
+using Stream = recording::Stream<Point>;
+constexpr ItemKind kKinds[] = {ItemKind::Truth, ItemKind::Measurement, ItemKind::Estimate};
 
 struct TrackRunResult final : RunResult {
   std::vector<Stream> streams;  // by input port x kind, as laid out in set_inputs
@@ -48,23 +43,12 @@ class TrackSink final : public Component, public FieldListCodec<TrackRunResult> 
  public:
   explicit TrackSink(const Params& p) : run_(static_cast<std::uint64_t>(p.integer("run"))) {}
 
-  void set_inputs(const std::vector<InputInfo>& inputs) override {
-    inputs_ = inputs;
-    index_.assign(inputs.size() * 3, -1);
-    streams_.clear();
-    for (size_t port = 0; port < inputs.size(); ++port)
-      for (ItemKind k : {ItemKind::Truth, ItemKind::Measurement, ItemKind::Estimate})
-        if (inputs[port].kinds & mask(k)) {
-          index_[port * 3 + slot(k)] = static_cast<int>(streams_.size());
-          streams_.push_back({k, {}});
-          names_.push_back(std::string(to_string(k)) + ":" + inputs[port].node);
-        }
-  }
+  void set_inputs(const std::vector<InputInfo>& inputs) override { streams_.lay_out(inputs, kKinds); }
 
   void start_run(const RunContext& ctx) override {
     active_ = ctx.run == run_;
     if (!active_) return;
-    for (auto& s : streams_) {
+    for (auto& s : streams_.streams()) {
       s.points.clear();
       s.points.reserve(kReserve);
     }
@@ -110,7 +94,7 @@ class TrackSink final : public Component, public FieldListCodec<TrackRunResult> 
     if (!active_) return nullptr;
     active_ = false;
     auto r = std::make_unique<TrackRunResult>();
-    r->streams = streams_;
+    r->streams = streams_.streams();
     return r;
   }
 
@@ -128,7 +112,7 @@ class TrackSink final : public Component, public FieldListCodec<TrackRunResult> 
     for (size_t i = 0; i < recorded_.size(); ++i) {
       const Stream& st = recorded_[i];
       Series s;
-      s.name = names_[i];
+      s.name = streams_.names()[i];
       s.description = std::string(to_string(st.kind)) + "s of run " + std::to_string(run_) + " in the ENU frame";
       s.add_column("time", "s");
       s.add_column("target");
@@ -150,18 +134,11 @@ class TrackSink final : public Component, public FieldListCodec<TrackRunResult> 
 
  private:
   static constexpr size_t kReserve = 8192;
-  static int slot(ItemKind k) { return k == ItemKind::Truth ? 0 : k == ItemKind::Measurement ? 1 : 2; }
-  Stream* stream(int port, ItemKind k) {
-    if (!active_ || port < 0 || static_cast<size_t>(port) * 3 >= index_.size()) return nullptr;
-    const int i = index_[static_cast<size_t>(port) * 3 + slot(k)];
-    return i < 0 ? nullptr : &streams_[static_cast<size_t>(i)];
-  }
+  static std::size_t slot(ItemKind k) { return k == ItemKind::Truth ? 0 : k == ItemKind::Measurement ? 1 : 2; }
+  Stream* stream(int port, ItemKind k) { return active_ ? streams_.find(port, slot(k)) : nullptr; }
 
   const std::uint64_t run_;
-  std::vector<InputInfo> inputs_;
-  std::vector<int> index_;  // (port, kind) -> stream
-  std::vector<Stream> streams_;
-  std::vector<std::string> names_;
+  recording::PortStreams<Point> streams_;
   bool active_ = false;
   // Aggregating instance.
   std::vector<Stream> recorded_;

@@ -8,28 +8,20 @@
 #include <string>
 #include <vector>
 
-#include "plugin_fixture.hpp"
+#include "scoring/track_set_fixture.hpp"
 
 using namespace trackflow;
 
+using test::metric;
+using test::track;
+
 namespace {
 
-TrackEstimate track(std::uint64_t id, Vec3 p, TrackStatus st = TrackStatus::Confirmed) {
-  TrackEstimate t;
-  t.id = id;
-  t.status = st;
-  t.estimate.initialised = true;
-  t.estimate.enu.setZero();
-  t.estimate.enu.head<3>() = p;
-  return t;
+std::shared_ptr<Component> make(const std::string& yaml = "{ cutoff: 5 m }") {
+  return test::make_track_set_sink("sink.track_quality", yaml);
 }
 
-std::shared_ptr<Component> make(const std::string& yaml = "{ cutoff: 5 m }") {
-  auto s = test::make("sink.track_quality", yaml);
-  s->set_inputs({{"tracker", "tracker.multi", mask(ItemKind::Tracks), {}},
-                 {"scenario", "sim.scenario", mask(ItemKind::Truth), {}}});
-  return s;
-}
+Summary finish(Component& s) { return test::finish_run(s); }
 
 // One step: truths (id = index unless given), then the track set.
 void step(Component& s, double time, const std::vector<Vec3>& truths, const std::vector<TrackEstimate>& tracks,
@@ -42,19 +34,6 @@ void step(Component& s, double time, const std::vector<Vec3>& truths, const std:
     s.on_truth(t, 1);
   }
   s.on_tracks(TrackSet{time, tracks}, 0);
-}
-
-Summary finish(Component& s) {
-  auto r = s.end_run();
-  s.merge(*r);
-  Summary sum;
-  s.finish(sum, {});
-  return sum;
-}
-
-double metric(const Summary& s, const std::string& name) {
-  const Metric* m = s.find(name);
-  return m ? m->value : -1.0;
 }
 
 const Vec3 A(0, 0, 0), B(100, 0, 0);

@@ -2,6 +2,7 @@
 #include "memory/grow.hpp"
 #include "scoring/gospa.hpp"
 #include "scoring/track_set_sink.hpp"
+#include "scoring/track_set_steps.hpp"
 
 #include <trackflow/number_text.hpp>
 #include <trackflow/plugin.hpp>
@@ -52,10 +53,9 @@ constexpr std::uint64_t kMaxId = 1u << 24;
 class TrackQualitySink final : public Component, public FieldListCodec<QualityRunResult> {
  public:
   explicit TrackQualitySink(const Params& p)
-      : gospa_(p.real("cutoff"), 2.0, 2.0),
-        statuses_(scoring::parse_track_statuses(p)),
-        planar_(scoring::planar_dimensions(p)),
-        skip_initial_(p.real("skip_initial")) {}
+      : gospa_(p.real("cutoff"), 2.0, 2.0), steps_in_(p) {
+    steps_in_.refuse_ids_from(kMaxId);
+  }
 
   void set_inputs(const std::vector<InputInfo>& inputs) override {
     scoring::check_track_set_inputs(inputs, "sink.track_quality");
@@ -65,68 +65,24 @@ class TrackQualitySink final : public Component, public FieldListCodec<QualityRu
     run_ = QualityRunResult{};
     targets_.clear();
     track_state_.clear();
-    truth_pos_.clear();
-    truth_ids_.clear();
-    have_batch_ = batch_used_ = false;
-    first_set_ = std::numeric_limits<double>::quiet_NaN();
+    steps_in_.start_run();
   }
 
-  void on_truth(const Truth& t, int) override {
-    if (!have_batch_ || t.time != batch_time_) {
-      if (have_batch_ && !batch_used_) ++run_.unscored_truth_steps;
-      have_batch_ = true;
-      batch_used_ = false;
-      batch_time_ = t.time;
-      truth_pos_.clear();
-      truth_ids_.clear();
-    }
-    if (!t.position.allFinite()) {
-      ++run_.non_finite;
-      return;
-    }
-    if (t.target >= kMaxId) {
-      ++run_.ids_out_of_range;
-      return;
-    }
-    truth_pos_.push_back(position(t.position));
-    truth_ids_.push_back(t.target);
-  }
+  void on_truth(const Truth& t, int) override { steps_in_.on_truth(t); }
 
+  // Truths and tracks come from scoring::TrackSetSteps: the truths of the set's time, the tracks of
+  // the chosen statuses, both with their ids.
   void on_tracks(const TrackSet& set, int) override {
-    if (std::isnan(first_set_)) first_set_ = set.time;
-    const bool truth_now = have_batch_ && batch_time_ == set.time;
-    if (truth_now) batch_used_ = true;
-    if (set.time < first_set_ + skip_initial_) return;
-    track_pos_.clear();
-    track_ids_.clear();
-    for (const TrackEstimate& te : set.tracks) {
-      if (!scoring::status_selected(statuses_, te.status) || !te.estimate.initialised) continue;
-      const Eigen::Vector3d p = position(te.estimate.enu.head<3>());
-      if (!p.allFinite()) {
-        ++run_.non_finite;
-        continue;
-      }
-      if (te.id >= kMaxId) {
-        ++run_.ids_out_of_range;
-        continue;
-      }
-      track_pos_.push_back(p);
-      track_ids_.push_back(te.id);
-    }
-    if (!truth_now) {
-      ++run_.steps_without_truth;
-      truth_pos_.clear();
-      truth_ids_.clear();
-    }
+    if (!steps_in_.on_tracks(set)) return;
+    const std::span<const std::uint64_t> truth_ids = steps_in_.truth_ids(), track_ids = steps_in_.track_ids();
     // Which track follows which truth: GOSPA's optimal assignment, pairs closer than the cut-off.
-    const metrics::GospaResult g = gospa_.evaluate<3>(std::span<const Eigen::Vector3d>(truth_pos_),
-                                                      std::span<const Eigen::Vector3d>(track_pos_));
+    const metrics::GospaResult g = steps_in_.score([this](auto truth, auto tracks) { return gospa_.evaluate(truth, tracks); });
     ++run_.steps;
-    run_.truth_steps += truth_pos_.size();
-    run_.track_steps += track_pos_.size();
-    memory::assign_grown(track_on_target_, track_pos_.size(), char{0});
-    for (std::size_t i = 0; i < truth_ids_.size(); ++i) {
-      TargetState& ts = target(truth_ids_[i]);
+    run_.truth_steps += truth_ids.size();
+    run_.track_steps += track_ids.size();
+    memory::assign_grown(track_on_target_, track_ids.size(), char{0});
+    for (std::size_t i = 0; i < truth_ids.size(); ++i) {
+      TargetState& ts = target(truth_ids[i]);
       if (!ts.seen) {
         ts.seen = true;
         ts.first_time = set.time;
@@ -138,7 +94,7 @@ class TrackQualitySink final : public Component, public FieldListCodec<QualityRu
         ts.tracked_last_step = false;
         continue;
       }
-      const std::uint64_t id = track_ids_[static_cast<std::size_t>(j)];
+      const std::uint64_t id = track_ids[static_cast<std::size_t>(j)];
       track_on_target_[static_cast<std::size_t>(j)] = 1;
       ++run_.tracked_truth_steps;
       if (!ts.established) {
@@ -150,8 +106,8 @@ class TrackQualitySink final : public Component, public FieldListCodec<QualityRu
       ts.last_track = id;
       ts.tracked_last_step = true;
     }
-    for (std::size_t j = 0; j < track_ids_.size(); ++j) {
-      TrackState& tr = track(track_ids_[j]);
+    for (std::size_t j = 0; j < track_ids.size(); ++j) {
+      TrackState& tr = track(track_ids[j]);
       if (!tr.seen) {
         tr.seen = true;
         ++run_.tracks;
@@ -162,8 +118,12 @@ class TrackQualitySink final : public Component, public FieldListCodec<QualityRu
   }
 
   std::unique_ptr<RunResult> end_run() override {
-    if (have_batch_ && !batch_used_) ++run_.unscored_truth_steps;
-    have_batch_ = false;
+    steps_in_.end_run();
+    const scoring::TrackSetCounts& c = steps_in_.counts();
+    run_.non_finite = c.non_finite_truths + c.non_finite_tracks;
+    run_.ids_out_of_range = c.ids_out_of_range;
+    run_.unscored_truth_steps = c.unscored_truth_steps;
+    run_.steps_without_truth = c.steps_without_truth;
     for (const TrackState& tr : track_state_)
       if (tr.seen && !tr.on_a_target) ++run_.tracks_never_on_a_target;
     return std::make_unique<QualityRunResult>(run_);
@@ -208,8 +168,6 @@ class TrackQualitySink final : public Component, public FieldListCodec<QualityRu
   }
 
  private:
-  Eigen::Vector3d position(const Eigen::Vector3d& p) const { return planar_ ? Eigen::Vector3d(p.x(), p.y(), 0.0) : p; }
-
   TargetState& target(std::uint64_t id) {
     if (id >= targets_.size()) {
       memory::reserve_grown(targets_, static_cast<std::size_t>(id) + 1);
@@ -226,18 +184,12 @@ class TrackQualitySink final : public Component, public FieldListCodec<QualityRu
   }
 
   metrics::Gospa gospa_;
-  std::uint8_t statuses_;
-  bool planar_;
-  double skip_initial_;
+  scoring::TrackSetSteps steps_in_;
   QualityRunResult run_, total_;
   std::uint64_t runs_ = 0;
   std::vector<TargetState> targets_;
   std::vector<TrackState> track_state_;
-  std::vector<Eigen::Vector3d> truth_pos_, track_pos_;
-  std::vector<std::uint64_t> truth_ids_, track_ids_;
   std::vector<char> track_on_target_;
-  bool have_batch_ = false, batch_used_ = false;
-  double batch_time_ = 0.0, first_set_ = 0.0;
 };
 
 void register_components(Registrar& r) {
