@@ -52,7 +52,7 @@ rm "$TMP/plugins/tfplugin_notours.so"
 for abi in 3 4; do
   cp "$PLUGINS/../old-abi-plugins/tfplugin_test_abi$abi.so" "$TMP/plugins/"
   expect_run "an ABI-$abi plugin is refused with a clear message" 2 \
-    "tfplugin_test_abi$abi.so: abi: built against plugin ABI $abi \\(SDK 0\\.$abi\\.[01]\\); this trackflow needs ABI 5 \\(SDK 0\\.5\\.[0-9]\\): rebuild the plugin" -- \
+    "tfplugin_test_abi$abi.so: abi: built against plugin ABI $abi \\(SDK 0\\.$abi\\.[01]\\); this trackflow needs ABI 6 \\(SDK 0\\.6\\.[0-9]\\): rebuild the plugin" -- \
     "$TF" plugins --no-default-plugins --plugin-path "$TMP/plugins"
   list | grep -q '"sink.metrics"' || fail "an ABI-$abi plugin in the folder stopped the other plugins from loading"
   rm "$TMP/plugins/tfplugin_test_abi$abi.so"
