@@ -86,7 +86,7 @@ void register_components(Registrar& r) {
   d.summary = "Two-point initiation from detections no track took, confirmed by the track score "
               "(sequential log-likelihood-ratio test)";
   d.doc = std::string(initiation::pairing_doc()) +
-          " Its score L starts at start_score and the tracker adds per look ln(P_D/beta_FA) + ln N(nu; 0, S) for "
+          " The track's score L starts at start_score and the tracker adds per look ln(P_D/beta_FA) + ln N(nu; 0, S) for "
           "a detection used and ln(1 - P_D) for a miss (Blackman & Popoli 1999, sec. 6.2), with the scan's P_D "
           "and clutter density beta_FA (a scan without them is refused). Wald's sequential probability ratio "
           "test: the track is confirmed when L >= ln((1 - beta)/alpha) and deleted when L <= ln(beta/(1 - alpha)) "
