@@ -9,6 +9,7 @@
 
 #include <boost/config.hpp>
 
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <span>
@@ -29,7 +30,30 @@ struct TrackView {
   // z^, S and log det S for this scan's sensor; nullptr when the track cannot predict the
   // measurement (S not positive definite): no detection may then be given to it.
   const PredictedMeasurement* predicted = nullptr;
+  // The track score L: the log-likelihood ratio of "a target" against "false alarms" of the
+  // detections the track used and the looks it missed (track_score below), and its largest value
+  // so far. It starts at TrackStart::score; NaN when a scan did not state P_D or its clutter density.
+  double score = 0.0;
+  double peak_score = 0.0;
 };
+
+// The track score's increment per look (Blackman & Popoli 1999, "Design and Analysis of Modern
+// Tracking Systems", §6.2, the track score; Blackman 2004, IEEE AES Magazine 19(1) pp. 5-18), kept
+// by the tracker, read by the parts (init.score, delete.score) — one formula for all of them.
+namespace track_score {
+// A look with detection z used: dL = ln(P_D / beta_FA) - (dim ln 2 pi + ln|S| + d^2) / 2, with
+// beta_FA the false-alarm density of the measurement space, S the innovation covariance and
+// d^2 = nu' S^-1 nu; the second term is ln N(nu; 0, S), the detection's likelihood under the track.
+inline double hit(double detection_probability, double clutter_density, double nis, double log_det_S, int dim) {
+  constexpr double kLog2Pi = 1.8378770664093454836;  // ln 2 pi
+  return std::log(detection_probability) - std::log(clutter_density) - 0.5 * (dim * kLog2Pi + log_det_S + nis);
+}
+// A look without one: dL = ln(1 - P_D P_G) (P_G: the probability that the target's detection
+// falls in the gate; 1 when the tracker knows no gate).
+inline double miss(double detection_probability, double gate_probability = 1.0) {
+  return std::log1p(-detection_probability * gate_probability);
+}
+}  // namespace track_score
 
 // The base of every part (ComponentDecl::create_part gives one). Visible, so that a tracker can
 // tell the part another plugin made (make_part's dynamic_cast across shared objects).
@@ -49,9 +73,11 @@ class BOOST_SYMBOL_VISIBLE Associator : public TrackerPart {
 
 // A new track's first detections: `first` from an earlier scan (time first_time), `second` the
 // index of a detection in the current scan; the tracker initiates a fresh estimator with both.
+// `score`: the track score L after the two (0: they are the reference the later looks add to).
 struct TrackStart {
   Measurement first;
   int second = -1;
+  double score = 0.0;
 };
 
 // Track initiation and confirmation.

@@ -1,4 +1,5 @@
 // Purpose: tracker.multi — a multi-target tracker composed of parts: per scan it predicts every track, lets the associator give detections to tracks, updates, confirms and deletes (initiator, deleter), starts tracks from what no track took (initiator), and publishes one TrackSet.
+#include "association/gating.hpp"
 #include "memory/grow.hpp"
 
 #include <trackflow/component.hpp>
@@ -9,6 +10,7 @@
 #include <trackflow/run_result_codec.hpp>
 #include <trackflow/tracker.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdint>
 #include <limits>
@@ -40,6 +42,7 @@ struct Track final : TrackContext {
   bool can_predict = false;
   int looks = 0;
   std::uint64_t history = 0;
+  double peak_score = 0.0;  // the largest track score so far (published.score is the current one)
   double last_time = 0.0;
   // Warnings of the estimator go to the tracker, which reports the first of each run.
   std::vector<std::string>* warnings = nullptr;
@@ -58,6 +61,8 @@ struct Track final : TrackContext {
     v.misses = published.misses;
     v.looks = looks;
     v.history = history;
+    v.score = published.score;
+    v.peak_score = peak_score;
     v.estimator = estimator.get();
     v.predicted = can_predict ? &predicted : nullptr;
     return v;
@@ -240,6 +245,7 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
         ++(used ? run_.updates : run_.updates_refused);
       }
       t.history = (t.history << 1) | (used ? 1u : 0u);
+      add_score(t, s, used ? &s.detections[static_cast<size_t>(assigned_[i])] : nullptr);
       if (used) {
         ++t.published.hits;
         t.published.misses = 0;
@@ -248,6 +254,23 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
       }
       views_[i] = t.view();
     }
+  }
+
+  // The look's track-score increment (tracker.hpp, track_score) with the scan's P_D and
+  // false-alarm density: a detection used is scored against the predicted measurement the
+  // associator saw (z^, S of this scan), a look without one as a miss. P_G = 1: the tracker does
+  // not know the associator's gate. A scan that states neither value makes the score NaN, for good.
+  void add_score(Track& t, const Scan& s, const Detection* used) {
+    const double pd = s.detection_probability, density = s.clutter_density;
+    double dL = std::numeric_limits<double>::quiet_NaN();
+    if (!used) {
+      if (pd >= 0.0 && pd <= 1.0) dL = track_score::miss(pd);
+    } else if (t.can_predict && gate_.set(t.predicted, s.sensor.frame) && pd > 0.0 && pd <= 1.0 && density > 0.0) {
+      dL = track_score::hit(pd, density, gate_.nis(used->value), t.predicted.log_det_S, gate_.dim());
+    }
+    double& L = t.published.score;
+    L += dL;
+    t.peak_score = std::isnan(L) ? L : std::max(t.peak_score, L);
   }
 
   // Tentative tracks confirmed or failed (the initiator), confirmed ones coasting or dropped (the deleter).
@@ -315,7 +338,8 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
       t.published.status = TrackStatus::Tentative;
       t.published.hits = 2;
       t.published.misses = 0;
-      t.published.score = std::numeric_limits<double>::quiet_NaN();
+      t.published.score = st.score;
+      t.peak_score = st.score;
       t.looks = 2;
       t.history = 0b11;
       t.last_time = s.time;
@@ -412,6 +436,7 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
   std::vector<int> assigned_, unassigned_;
   std::vector<char> taken_;
   std::vector<TrackStart> starts_;
+  association::PredictedGate gate_;
   std::vector<TrackEstimate> set_;
   std::vector<std::string> warnings_;
   bool warned_ = false;
@@ -443,7 +468,11 @@ void register_components(Registrar& r) {
       "tracks or fails them, the deleter drops confirmed ones; the initiator starts tracks from the detections no "
       "track took; the set of all tracks is published (a deleted track once, with status deleted). Track ids are "
       "unique in a run and never reused. A scan with valid: false (the sensor did not look) changes nothing. A track "
-      "whose state comes out non-finite is deleted and counted. The estimator is any filter type with a per-track "
+      "whose state comes out non-finite is deleted and counted. Each track keeps its score L, the log-likelihood "
+      "ratio of target against false alarms (Blackman & Popoli 1999, sec. 6.2), published as the track's score: it "
+      "starts at the initiator's value (0 by default) and adds per look ln(P_D/beta_FA) + ln N(nu; 0, S) for a "
+      "detection used, ln(1 - P_D) for a miss, with the scan's P_D and clutter density beta_FA (NaN when the scan "
+      "states them not); init.score and delete.score read it. The estimator is any filter type with a per-track "
       "estimator (filter.kalman, filter.ekf, filter.ukf, filter.imm, ...), with that filter's parameters. See "
       "docs/multi-target.md.";
   d.accepts = mask(ItemKind::Scan);

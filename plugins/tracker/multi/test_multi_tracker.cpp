@@ -1,4 +1,4 @@
-// Purpose: tests of tracker.multi with filter.kalman, assoc.gnn / assoc.nearest, init.m_of_n and delete.misses, scans fed by hand: two targets in clutter become two confirmed tracks that keep their targets; ids are never reused; a track is deleted after its misses; a scan that was not a look changes nothing; the run result survives the codec.
+// Purpose: tests of tracker.multi with filter.kalman, assoc.gnn / assoc.nearest, init.m_of_n and delete.misses, scans fed by hand: two targets in clutter become two confirmed tracks that keep their targets; ids are never reused; a track is deleted after its misses; a scan that was not a look changes nothing; each track's score gains the hit or miss increment per look; the run result survives the codec.
 #include <catch2/catch.hpp>
 
 #include "plugin_fixture.hpp"
@@ -7,6 +7,8 @@
 #include <trackflow/run_result_codec.hpp>
 #include <trackflow/tracks.hpp>
 
+#include <cmath>
+#include <limits>
 #include <map>
 #include <memory>
 #include <set>
@@ -213,4 +215,46 @@ TEST_CASE("coasting tracks and reused slots carry nothing stale") {
       CHECK(a.estimate.innovation.size() == b.estimate.innovation.size());
     }
   }
+}
+
+// The track score (tracker.hpp, track_score) per look: a detection used adds ln(P_D / beta) +
+// ln N(nu; 0, S), recomputed here from the estimator's published innovation and S; a miss adds
+// ln(1 - P_D); a scan that states no P_D makes it NaN.
+TEST_CASE("the track score: a hit or miss increment per look") {
+  auto n = test::make("tracker.multi", tracker_yaml("assoc.gnn", 3));
+  SetCollector out;
+  out.attach_to(*n);
+  test::start_run(*n);
+  Scenario sc;
+  std::map<std::uint64_t, double> previous;
+  int hits = 0, misses = 0;
+  for (int k = 0; k < 10; ++k) {
+    n->on_scan(sc.scan_at(k, 0, k != 5 && k != 6), 0);  // target 2 unseen at t = 5, 6 s
+    const double pd = 0.99, beta = 1e-9;
+    for (const TrackEstimate& t : out.sets.back().tracks) {
+      if (!previous.count(t.id)) {
+        CHECK(t.score == 0.0);  // init.m_of_n's starts: the two initiating detections are the reference
+      } else if (t.estimate.updated) {
+        const Eigen::VectorXd nu = t.estimate.innovation;
+        const Eigen::MatrixXd S = t.estimate.innovation_covariance;
+        const double dL = std::log(pd / beta) - 0.5 * (nu.dot(S.inverse() * nu) + std::log(S.determinant()) +
+                                                       3.0 * std::log(2.0 * std::acos(-1.0)));
+        CHECK(t.score - previous[t.id] == Approx(dL).epsilon(1e-9));
+        ++hits;
+      } else {
+        CHECK(t.score - previous[t.id] == Approx(std::log(0.01)).epsilon(1e-12));
+        ++misses;
+      }
+      previous[t.id] = t.score;
+    }
+  }
+  CHECK(hits >= 10);
+  CHECK(misses == 2);
+  // A scan without P_D: no score from then on (init.m_of_n and delete.misses do not need one).
+  Scan silent = sc.scan_at(10, 0);
+  silent.detection_probability = std::numeric_limits<double>::quiet_NaN();
+  n->on_scan(silent, 0);
+  n->on_scan(sc.scan_at(11, 0), 0);
+  REQUIRE(confirmed(out.sets.back()).size() == 2);
+  for (const TrackEstimate* t : confirmed(out.sets.back())) CHECK(std::isnan(t->score));
 }
