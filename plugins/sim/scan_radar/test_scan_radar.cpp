@@ -65,7 +65,7 @@ Vec3 at(double r, double az, double el) { return spherical_to_enu(r, az, el, Azi
 
 }  // namespace
 
-TEST_CASE("scan_radar: one scan per instant, with every target of it", "[scan_radar]") {
+TEST_CASE("one scan per instant with every target of it", "[scan_radar]") {
   Radar radar("range_max: 100 km\nsigma_range: 0 m\nsigma_azimuth: 0 rad\nsigma_elevation: 0 rad\n");
   radar.truth(1.0, 3, at(10e3, 0.5, 0.1));
   radar.truth(1.0, 1, at(20e3, -0.5, 0.2));
@@ -91,7 +91,7 @@ TEST_CASE("scan_radar: one scan per instant, with every target of it", "[scan_ra
   CHECK(radar.rec.looks[1].detections[0].value[0] == Approx(21e3));
 }
 
-TEST_CASE("scan_radar: targets outside the coverage are not seen", "[scan_radar]") {
+TEST_CASE("targets outside the coverage are not seen", "[scan_radar]") {
   Radar radar("range_min: 1 km\nrange_max: 50 km\nazimuth_min: 170 deg\nazimuth_max: 200 deg\n"
               "elevation_min: 1 deg\nelevation_max: 30 deg\n");
   radar.truth(0.0, 0, at(10e3, 180 * kDeg, 5 * kDeg));   // in (azimuth interval passes 180 deg)
@@ -108,7 +108,7 @@ TEST_CASE("scan_radar: targets outside the coverage are not seen", "[scan_radar]
   CHECK(seen == std::vector<std::uint32_t>{0, 1});
 }
 
-TEST_CASE("scan_radar: Swerling P_D formulas match a simulated square-law detector", "[scan_radar]") {
+TEST_CASE("Swerling P_D matches a simulated square-law detector", "[scan_radar]") {
   // Complex Gaussian noise of unit power per sample; the threshold gives P_FA on noise alone.
   Rng rng(7);
   const double pfa = 1e-2, threshold = -std::log(pfa);  // |n|^2 ~ Exp(1): P(|n|^2 > T) = e^-T
@@ -136,7 +136,7 @@ TEST_CASE("scan_radar: Swerling P_D formulas match a simulated square-law detect
   CHECK(10.0 * std::log10(scan_radar::snr_at_range(1000e3, 20.0, 100e3)) == Approx(-20.0));
 }
 
-TEST_CASE("scan_radar: detection rate follows P_D and clutter its mean and coverage", "[scan_radar]") {
+TEST_CASE("detections follow P_D and clutter its mean and region", "[scan_radar]") {
   Radar radar("range_min: 10 km\nrange_max: 20 km\nazimuth_min: 0 deg\nazimuth_max: 90 deg\n"
               "elevation_min: 0 deg\nelevation_max: 10 deg\ndetection_probability: 0.7\nclutter_rate: 5\n");
   const int looks = 4000;
@@ -167,7 +167,7 @@ TEST_CASE("scan_radar: detection rate follows P_D and clutter its mean and cover
   CHECK(radar.rec.looks[0].clutter_density == Approx(5.0 / volume));
 }
 
-TEST_CASE("scan_radar: Swerling clutter defaults to P_FA times the resolution cells", "[scan_radar]") {
+TEST_CASE("Swerling clutter defaults to P_FA times the cells", "[scan_radar]") {
   Radar radar("range_min: 0 m\nrange_max: 15 km\nazimuth_min: 0 deg\nazimuth_max: 10 deg\nelevation_min: 0 deg\n"
               "elevation_max: 1 deg\nrange_resolution: 15 m\nbeamwidth_azimuth: 1 deg\nbeamwidth_elevation: 1 deg\n"
               "detection_model: swerling1\nfalse_alarm_probability: 1e-3\n");
@@ -180,7 +180,7 @@ TEST_CASE("scan_radar: Swerling clutter defaults to P_FA times the resolution ce
   CHECK(radar.rec.looks[0].clutter_density * volume == Approx(10.0));
 }
 
-TEST_CASE("scan_radar: targets in one resolution cell give one plot", "[scan_radar]") {
+TEST_CASE("targets in one resolution cell give one plot", "[scan_radar]") {
   const std::string yaml = "range_max: 100 km\nsigma_range: 0 m\nsigma_azimuth: 0 rad\nsigma_elevation: 0 rad\n"
                            "range_resolution: 50 m\nbeamwidth_azimuth: 1 deg\nbeamwidth_elevation: 1 deg\n";
   Radar merged(yaml + "merge_unresolved: true\n"), apart(yaml);
@@ -199,7 +199,7 @@ TEST_CASE("scan_radar: targets in one resolution cell give one plot", "[scan_rad
   CHECK(d[1].origin == 9);
 }
 
-TEST_CASE("scan_radar: same seed same scans, another seed other scans", "[scan_radar]") {
+TEST_CASE("same seed same scans and another seed other scans", "[scan_radar]") {
   auto run = [](std::uint64_t seed) {
     Radar r("range_max: 50 km\ndetection_probability: 0.8\nclutter_rate: 3\n", seed);
     for (int k = 0; k < 50; ++k) {
@@ -216,7 +216,7 @@ TEST_CASE("scan_radar: same seed same scans, another seed other scans", "[scan_r
   CHECK(run(5) != run(6));
 }
 
-TEST_CASE("scan_radar: refuses contradictory or impossible parameters", "[scan_radar]") {
+TEST_CASE("refuses contradictory or impossible parameters", "[scan_radar]") {
   CHECK_THAT(refusal("range_max: 10 km\nrange_min: 20 km\n"), Catch::Contains("above range_min"));
   CHECK_THAT(refusal("range_max: 10 km\nazimuth_min: 10 deg\nazimuth_max: 5 deg\n"), Catch::Contains("above azimuth_min"));
   CHECK_THAT(refusal("range_max: 10 km\nazimuth_min: 200 deg\nazimuth_max: 210 deg\n"), Catch::Contains("[-180 deg, 180 deg]"));

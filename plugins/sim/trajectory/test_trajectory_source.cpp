@@ -527,7 +527,7 @@ TEST_CASE("process noise parameters are checked") {
 
 // A jettisoned body starts on its parent's sample grid at the separation, with the parent's state
 // plus the separation velocity, then falls freely (closed form) until it is back on the ground.
-TEST_CASE("a jettisoned body falls from its parent's state at separation") {
+TEST_CASE("a jettisoned body falls from its parent's state") {
   const std::string flight = R"(
     rate: 10 Hz
     initial_position: [0 m, 0 m, 1000 m]
