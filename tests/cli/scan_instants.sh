@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Purpose: the engine closes an instant once every source has emitted all of its time: two truth sources at 10 Hz and 4 Hz into one sim.scan_radar give one look per distinct time (121 in 10 s), each with every target of that time, for any --threads and in every run; a source.csv of detections is a scan source: a tracker takes it, a filter is refused at its input line.
+# Purpose: the engine closes an instant once every source has emitted all of its time: two truth sources at 10 Hz and 4 Hz into one sim.scan_radar give one look per distinct time (121 in 10 s), each with every target of that time, for any --threads and in every run; a source.csv of detections is a scan source: a tracker takes it, a filter is refused at its input line; a truth log (content: truth) scores it.
 set -u
 TF=$1
 source "$(dirname "$0")/lib.sh"
@@ -60,6 +60,32 @@ nodes:
 YAML
 expect_run "a detection log through tracker.multi: two tracks" 0 "tracks_confirmed_per_run +2$" -- "$TF" run "$TMP/log.yaml"
 expect_run "a detection log counts its scans" 0 "scans +10$" -- "$TF" run "$TMP/log.yaml"
+# Recorded data scored: the same log against a truth log (content: truth) by sink.gospa.
+{
+  echo "time,target,x,y,z,vx,vy,vz"
+  for k in 0 1 2 3 4 5 6 7 8 9; do echo "$k,0,$((10 * k)),5,0,10,0,0"; echo "$k,1,$((10 * k)),-300,0,10,0,0"; done
+} > "$TMP/truth.csv"
+# Sources tie at one time in declaration order, and a sink scores a track set against the truth
+# already delivered for its time: the truth log is declared first. Declared after the detection log,
+# every track set comes before its truth, which the sink counts and explains.
+truth_node='  - id: truth
+    type: source.csv
+    params: { path: truth.csv, content: truth, frame: cartesian, vx_column: vx, vy_column: vy, vz_column: vz }'
+gospa_node='  - id: gospa
+    type: sink.gospa
+    inputs: [mtt, truth]
+    params: { cutoff: 20 m, skip_initial: 3 s }'
+{ head -2 "$TMP/log.yaml"; echo "$truth_node"; tail -n +3 "$TMP/log.yaml"; echo "$gospa_node"; } > "$TMP/scored.yaml"
+expect_run "a detection log scored against a truth log: both targets every step" 0 "truths +2$" -- "$TF" run "$TMP/scored.yaml"
+expect_run "a detection log scored against a truth log: no step without its truth" 0 "steps_without_truth +0$" -- \
+  "$TF" run "$TMP/scored.yaml"
+expect_run "a detection log scored against a truth log: tracks on their targets" 0 "missed_targets +0$" -- \
+  "$TF" run "$TMP/scored.yaml"
+{ cat "$TMP/log.yaml"; echo "$truth_node"; echo "$gospa_node"; } > "$TMP/late_truth.yaml"
+expect_run "truth declared after the scans: counted and explained" 0 \
+  "steps_without_truth +7$" -- "$TF" run "$TMP/late_truth.yaml"
+expect_run "truth declared after the scans: the note says what to do" 0 \
+  "declare that source before the scan source" -- "$TF" run "$TMP/late_truth.yaml"
 head -5 "$TMP/log.yaml" > "$TMP/filter.yaml"
 printf '  - { id: mtt, type: filter.kalman,\n      input: log }\n' >> "$TMP/filter.yaml"
 line=$(grep -n "input: log" "$TMP/filter.yaml" | cut -d: -f1)

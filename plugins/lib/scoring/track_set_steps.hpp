@@ -181,11 +181,17 @@ inline void publish_counts(Summary& s, std::uint64_t scored_runs, std::uint64_t 
   s.metric("steps_without_truth", static_cast<double>(c.steps_without_truth));
 }
 
-inline void note_non_finite(Summary& s, const TrackSetCounts& c) {
+inline void note_left_out(Summary& s, const TrackSetCounts& c) {
   if (c.non_finite_tracks || c.non_finite_truths)
     s.notes.push_back("positions that are not finite were left out of the sets: " +
                       std::to_string(c.non_finite_tracks) + " tracks, " + std::to_string(c.non_finite_truths) +
                       " truths");
+  // The usual cause: truth of a time reaches the sink after the track set of that time, because its
+  // source is declared after the scan source (sources tie at one time in declaration order).
+  if (c.steps_without_truth && c.unscored_truth_steps)
+    s.notes.push_back(std::to_string(c.steps_without_truth) + " track set(s) came before any truth of their time and " +
+                      std::to_string(c.unscored_truth_steps) + " truth step(s) after their track set: if the truth "
+                      "comes from its own source (a truth log), declare that source before the scan source");
 }
 
 // Means over runs of N per-run means, and a 95 % Student-t interval of the mean of the run means.
@@ -344,9 +350,9 @@ class TrackSetScores {
   }
   // The per-step means, when `series` and any step was scored.
   const StepMeans<N>* by_time() const { return series_ && !by_time_.empty() ? &by_time_ : nullptr; }
-  // The counters as metrics and the note on non-finite positions (publish_counts, note_non_finite).
+  // The counters as metrics and the note on non-finite positions (publish_counts, note_left_out).
   void publish_counts(Summary& s) const { scoring::publish_counts(s, means_.runs(), steps_, counts_); }
-  void note_non_finite(Summary& s) const { scoring::note_non_finite(s, counts_); }
+  void note_left_out(Summary& s) const { scoring::note_left_out(s, counts_); }
 
  private:
   TrackSetSteps steps_in_;

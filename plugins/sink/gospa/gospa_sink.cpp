@@ -60,7 +60,7 @@ class GospaSink final : public Component, public FieldListCodec<scoring::StepRun
         "gospa: mean over a run's steps of d, then over runs; gospa_pow_p: the same of d^p" +
         (parts ? ", = gospa_localisation + gospa_missed + gospa_false (means of the p-th-power parts)" : "") +
         "; missed_targets / false_tracks: per step, truths / tracks without a partner closer than c");
-    scores_.note_non_finite(s);
+    scores_.note_left_out(s);
     if (const auto* by_time = scores_.by_time())
       s.series.push_back(by_time->series(
           "gospa",

@@ -54,7 +54,7 @@ class OspaSink final : public Component, public FieldListCodec<scoring::StepRunR
                       ") per TrackSet against the truths of exactly its time; ospa: mean over a run's steps of d, "
                       "then over runs; ospa_pow_p: the same of d^p, = ospa_localisation + ospa_cardinality (the "
                       "two terms of d^p, each divided by the larger set's size)");
-    scores_.note_non_finite(s);
+    scores_.note_left_out(s);
     if (const auto* by_time = scores_.by_time())
       s.series.push_back(by_time->series("ospa",
                                          "per time step, means over the runs with a track set at that step: OSPA, "

@@ -47,7 +47,7 @@ enum class TimeUnit { Second, Millisecond };
 enum class LengthUnit { Metre, Kilometre };
 enum class AngleUnit { Degree, Radian, Milliradian };
 enum class OnBadRow { Error, Skip };
-enum class Content { Measurements, Detections };
+enum class Content { Measurements, Detections, Truth };
 
 double angle_scale(AngleUnit unit) {
   if (unit == AngleUnit::Degree) return std::numbers::pi / 180.0;
@@ -138,7 +138,7 @@ bool plausible_header(const std::vector<std::string>& names) {
 }
 
 // The columns a source may read, in the order their positions are kept.
-constexpr int kColumns = 11;
+constexpr int kColumns = 15;
 
 // What checking the whole file found, shared read-only by every instance (one per worker
 // thread, plus the one that aggregates) built from the same file and parameters. No rows are
@@ -259,7 +259,9 @@ class CsvSource final : public Generator {
 
   FrameMask produced_frames() const override { return mask(frame_); }
   ItemMask produced_kinds() const override {
-    return mask(content_ == Content::Detections ? ItemKind::Scan : ItemKind::Measurement);
+    return mask(content_ == Content::Detections ? ItemKind::Scan
+                : content_ == Content::Truth    ? ItemKind::Truth
+                                                : ItemKind::Measurement);
   }
 
   double next_time() const override { return has_current_ ? current_.time : std::numeric_limits<double>::infinity(); }
@@ -268,6 +270,15 @@ class CsvSource final : public Generator {
     if (!has_current_) return;
     if (content_ == Content::Measurements) {
       out.emit(current_);
+      advance();
+      return;
+    }
+    if (content_ == Content::Truth) {
+      truth_.time = current_.time;
+      truth_.target = row_target_;
+      truth_.position = current_.value.head<3>();
+      truth_.velocity = row_velocity_;
+      out.emit(truth_);
       advance();
       return;
     }
@@ -294,7 +305,8 @@ class CsvSource final : public Generator {
 
  private:
   std::array<Column*, kColumns> columns() {
-    return {&time_, &value_[0], &value_[1], &value_[2], &range_rate_, &snr_, &mode_, &valid_, &sensor_, &scan_id_, &origin_};
+    return {&time_, &value_[0], &value_[1], &value_[2], &range_rate_, &snr_, &mode_, &valid_, &sensor_, &scan_id_, &origin_,
+            &target_, &velocity_[0], &velocity_[1], &velocity_[2]};
   }
 
   // Rows of one scan: the same scan id with a scan column, else the same time.
@@ -312,6 +324,20 @@ class CsvSource final : public Generator {
                                     "look that saw nothing is a row whose value cells are empty");
     scan_.detection_probability = p.has("detection_probability") ? p.real("detection_probability") : std::numeric_limits<double>::quiet_NaN();
     scan_.clutter_density = p.has("clutter_density") ? p.real("clutter_density") : std::numeric_limits<double>::quiet_NaN();
+    if (content_ == Content::Truth) {
+      if (p.choice<LogFrame>("frame") != LogFrame::Cartesian)
+        throw p.error(p.given("frame") ? "frame" : "content", "a truth log holds ENU positions: give frame: cartesian");
+      for (const char* name : {"range_rate_column", "snr_column", "mode_column", "valid_column", "sensor_column",
+                               "origin_column", "sigma_position", "sigma_range_rate"})
+        if (p.given(name)) throw p.error(name, "applies to logs of measurements or detections, not to content: truth");
+      const int velocities = p.given("vx_column") + p.given("vy_column") + p.given("vz_column");
+      if (velocities != 0 && velocities != 3)
+        throw p.error(p.given("vx_column") ? "vx_column" : p.given("vy_column") ? "vy_column" : "vz_column",
+                      "give vx_column, vy_column and vz_column together (or none: velocity 0)");
+    } else {
+      for (const char* name : {"target_column", "vx_column", "vy_column", "vz_column"})
+        if (p.given(name)) throw p.error(name, "applies only to content: truth");
+    }
     const bool cartesian = p.choice<LogFrame>("frame") == LogFrame::Cartesian;
     frame_ = cartesian ? Frame::Cartesian : Frame::Spherical;
     // A parameter of the other frame would be silently ignored; say so instead.
@@ -359,6 +385,12 @@ class CsvSource final : public Generator {
     sensor_ = column("sensor_column");
     scan_id_ = column("scan_column");
     origin_ = column("origin_column");
+    if (content_ == Content::Truth) {
+      target_ = column("target_column");
+      velocity_[0] = column("vx_column");
+      velocity_[1] = column("vy_column");
+      velocity_[2] = column("vz_column");
+    }
 
     Measurement& m = prototype_;
     m.frame = cartesian ? Frame::Cartesian : Frame::Spherical;
@@ -615,6 +647,18 @@ class CsvSource final : public Generator {
       return complain("", "not a validity flag (expected 1, 0, true or false)", valid_);
     if (sensor_.read() && csv::parse_id(fields[sensor_.index], m.sensor) != csv::CellStatus::Ok)
       return complain("", "not a sensor id (expected a non-negative integer)", sensor_);
+    if (target_.read() && csv::parse_id(fields[target_.index], row_target_) != csv::CellStatus::Ok)
+      return complain("", "not a target id (expected a non-negative integer)", target_);
+    for (int k = 0; k < 3; ++k) {
+      if (!velocity_[k].read()) {
+        row_velocity_[k] = 0.0;
+        continue;
+      }
+      double v = 0.0;
+      if (!real(velocity_[k], v)) return false;
+      row_velocity_[k] = v * scale_[k];  // the position unit per second
+      if (!std::isfinite(row_velocity_[k])) return complain("", "value overflows when converted to SI", velocity_[k]);
+    }
     m.origin = kOriginUnknown;
     if (origin_.read()) {
       const std::string_view o = fields[origin_.index];
@@ -651,7 +695,7 @@ class CsvSource final : public Generator {
   bool skip_bad_rows_ = false;
   std::string file_;
   Content content_ = Content::Measurements;
-  Column time_, value_[3], range_rate_, snr_, mode_, valid_, sensor_, scan_id_, origin_;
+  Column time_, value_[3], range_rate_, snr_, mode_, valid_, sensor_, scan_id_, origin_, target_, velocity_[3];
   double time_scale_ = 1.0, scale_[3] = {1.0, 1.0, 1.0}, rdot_scale_ = 1.0;
   Measurement prototype_;
   std::size_t field_count_ = 0;
@@ -677,6 +721,10 @@ class CsvSource final : public Generator {
   Scan scan_;
   std::uint32_t row_scan_ = 0;
   bool row_empty_ = false;
+  // content: truth — the row's target id and velocity, and the item emitted.
+  std::uint32_t row_target_ = 0;
+  Vec3 row_velocity_ = Vec3::Zero();
+  Truth truth_;
 };
 
 std::vector<ParamSpec> csv_params() {
@@ -698,12 +746,17 @@ std::vector<ParamSpec> csv_params() {
       P::string("mode_column", "column with the track mode: beacon or skin (any case), anything else is unknown"),
       P::string("valid_column", "column with the validity flag: 1/0/true/false; invalid rows make filters coast"),
       P::string("sensor_column", "column with the sensor id (non-negative integer); overrides sensor_id"),
-      P::choice<Content>("content", {{Content::Measurements, "measurements"}, {Content::Detections, "detections"}},
-                         "what the source emits: one measurement per row, or scans of detections (rows grouped by "
-                         "scan_column, or by equal time)")
+      P::choice<Content>("content",
+                         {{Content::Measurements, "measurements"}, {Content::Detections, "detections"}, {Content::Truth, "truth"}},
+                         "what the source emits: one measurement per row, scans of detections (rows grouped by "
+                         "scan_column, or by equal time), or one truth per row (to score recorded data)")
           .def("measurements"),
       P::string("scan_column", "detections: column with the scan number (non-negative integer); consecutive rows with "
                                "the same number are one scan (default: rows of equal time)"),
+      P::string("target_column", "truth: column with the target id (non-negative integer)").def("target"),
+      P::string("vx_column", "truth: column with the east velocity (position unit per second; with vy, vz; default 0)"),
+      P::string("vy_column", "truth: column with the north velocity"),
+      P::string("vz_column", "truth: column with the up velocity"),
       P::string("origin_column", "column with each row's origin, for scoring: a target id, 'clutter', or empty (unknown)"),
       P::real("detection_probability", dim::none, "detections: the P_D the scans state (default: not stated)").at_least(0).at_most(1),
       P::real("clutter_density", Dimension{}, "detections: the clutter density the scans state, per unit of measurement "
@@ -753,11 +806,15 @@ void register_components(Registrar& r) {
           "no detections, which a tracker counts as a miss for every track, unlike no scan at all). origin_column "
           "labels rows for scoring (a target id, 'clutter', or empty for unknown); estimators never read it. The "
           "scans state no region; their P_D and clutter density are the parameters' when given, else unknown "
-          "(NaN: give the associator its own). Metrics add scans.";
+          "(NaN: give the associator its own). Metrics add scans.\n"
+          "content: truth replays a truth log (frame: cartesian): per row one Truth of target target_column at "
+          "x, y, z (position_unit) with velocity vx, vy, vz when those columns are given (else 0) and acceleration 0, "
+          "in time order, so a recorded run (e.g. GPS or ADS-B reference positions) can be scored by the sinks.";
   d.params = csv_params();
   d.min_inputs = 0;
   d.max_inputs = 0;
-  d.produces = ItemKind::Measurement | ItemKind::Scan;  // one of the two, as `content` says (produced_kinds)
+  // One of the three, as `content` says (produced_kinds).
+  d.produces = mask(ItemKind::Measurement) | mask(ItemKind::Scan) | mask(ItemKind::Truth);
   d.time_ordered = true;  // rows out of time order are refused or skipped (on_bad_row)
   d.create = [](const Params& p) { return std::make_unique<CsvSource>(p); };
   r.add(std::move(d));

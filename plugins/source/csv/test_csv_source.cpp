@@ -531,6 +531,16 @@ class ScanRecorder final : public Component {
   std::vector<RecordedScan> scans;
 };
 
+// The message of whatever building source.csv on `file` with `extra` parameters throws ("" if none).
+std::string refusal(const std::string& file, const std::string& extra) {
+  try {
+    (void)test::make("source.csv", yaml_params(file, extra));
+  } catch (const std::exception& e) {
+    return e.what();
+  }
+  return {};
+}
+
 std::vector<RecordedScan> read_scans(const std::string& file, const std::string& extra) {
   auto src = test::make("source.csv", yaml_params(file, "content: detections" + (extra.empty() ? "" : ", " + extra)));
   CHECK(src->produced_kinds() == mask(ItemKind::Scan));
@@ -588,19 +598,38 @@ TEST_CASE("content detections groups rows by the scan column") {
 TEST_CASE("content detections refuses what does not belong to it") {
   TempDir dir;
   const std::string file = dir.write("plots.csv", "time,range,azimuth,elevation,valid,scan,origin\n1,1000,10,1,1,x,-2\n");
-  auto refusal = [&](const std::string& extra) -> std::string {
-    try {
-      (void)test::make("source.csv", yaml_params(file, extra));
-    } catch (const std::exception& e) {
-      return e.what();
-    }
-    return {};
-  };
-  CHECK_THAT(refusal("scan_column: scan"), Catch::Contains("content: detections"));
-  CHECK_THAT(refusal("content: detections, valid_column: valid"), Catch::Contains("value cells are empty"));
-  CHECK_THAT(refusal("content: detections, scan_column: scan"), Catch::Contains("not a scan id"));
-  CHECK_THAT(refusal("content: detections, origin_column: origin"), Catch::Contains("not an origin"));
+  CHECK_THAT(refusal(file, "scan_column: scan"), Catch::Contains("content: detections"));
+  CHECK_THAT(refusal(file, "content: detections, valid_column: valid"), Catch::Contains("value cells are empty"));
+  CHECK_THAT(refusal(file, "content: detections, scan_column: scan"), Catch::Contains("not a scan id"));
+  CHECK_THAT(refusal(file, "content: detections, origin_column: origin"), Catch::Contains("not an origin"));
   // A measurement log emits measurements only.
   auto src = test::make("source.csv", yaml_params(file));
   CHECK(src->produced_kinds() == mask(ItemKind::Measurement));
+}
+
+// A truth log: one Truth per row, its target and velocity from their columns (km and km/s here).
+TEST_CASE("content truth replays targets with their velocities") {
+  TempDir dir;
+  const std::string file = dir.write("truth.csv",
+                                     "time,target,x,y,z,vx,vy,vz\n"
+                                     "0,4,1,2,0.5,0.1,0,0\n"
+                                     "0,9,-1,-2,0.5,0,0.2,0\n"
+                                     "1,4,1.1,2,0.5,0.1,0,0\n");
+  auto src = test::make("source.csv", yaml_params(file, "content: truth, frame: cartesian, position_unit: km, "
+                                                        "vx_column: vx, vy_column: vy, vz_column: vz"));
+  CHECK(src->produced_kinds() == mask(ItemKind::Truth));
+  test::Collector out;
+  out.attach_to(*src);
+  test::drain(*src);
+  REQUIRE(out.truths.size() == 3);
+  CHECK(out.truths[1].target == 9);
+  CHECK(out.truths[1].position.x() == -1000.0);
+  CHECK(out.truths[1].velocity.y() == Approx(200.0));
+  CHECK(out.truths[2].time == 1.0);
+  CHECK(out.truths[2].position.x() == Approx(1100.0));
+  // Refusals: a spherical truth log, half the velocity columns, a truth-only column elsewhere.
+  CHECK_THAT(refusal(file, "content: truth"), Catch::Contains("frame: cartesian"));
+  CHECK_THAT(refusal(file, "content: truth, frame: cartesian, vx_column: vx"), Catch::Contains("together"));
+  CHECK_THAT(refusal(file, "frame: cartesian, target_column: target"), Catch::Contains("only to content: truth"));
+  CHECK_THAT(refusal(file, "content: truth, frame: cartesian, target_column: id"), Catch::Contains("no column 'id'"));
 }
