@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Purpose: the engine closes an instant once every source has emitted all of its time: two truth sources at 10 Hz and 4 Hz into one sim.scan_radar give one look per distinct time (121 in 10 s), each with every target of that time, for any --threads and in every run; a source.csv of detections is a scan source: a tracker takes it, a filter is refused at its input line; a truth log (content: truth) scores it.
+# Purpose: the engine closes an instant once every source has emitted all of its time: two truth sources at 10 Hz and 4 Hz into one sim.scan_radar give one look per distinct time (121 in 10 s), each with every target of that time, for any --threads and in every run; a source.csv of detections is a scan source: a tracker takes it, a filter is refused at its input line; a truth log (content: truth) scores it; sink.csv writes the looks.
 set -u
 TF=$1
 source "$(dirname "$0")/lib.sh"
@@ -33,6 +33,21 @@ for threads in 1 2; do
   expect_run "every target of an instant in its look, --threads $threads" 0 "target_detections +142$" -- \
     "$TF" run "$TMP/instants.yaml" --threads $threads
 done
+# The looks written by sink.csv: one detection row per target and look, origin = the target id.
+cat >> "$TMP/instants.yaml" <<'YAML'
+  - id: plots
+    type: sink.csv
+    inputs: [radar, fast, slow]
+    params: { include_detections: true }
+YAML
+expect_run "sink.csv writes the scans" 0 "wrote .*plots.csv" -- "$TF" run "$TMP/instants.yaml" --out "$TMP/out"
+rows=$(grep -c ',detection,' "$TMP/out/plots.csv")
+[ "$rows" -eq $((4 * 142)) ] || fail "sink.csv wrote $rows detection rows, expected 4 runs x 142"
+awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) if ($i == "origin") o = i; next } $4 == "detection" && $o != 0 && $o != 1 { bad++ }
+         END { exit bad > 0 || o == 0 }' "$TMP/out/plots.csv" || fail "sink.csv: a detection row without its target's origin"
+checks=$((checks + 1))
+echo "ok: every detection row has its origin"
+sed -i '/id: plots/,$d' "$TMP/instants.yaml"
 # A single source emitting its targets one item at a time (sim.trajectory) still closes each instant.
 sed -i 's/inputs: \[fast, slow\]/inputs: [fast]/' "$TMP/instants.yaml"
 expect_run "a single source: one look per sample" 0 "looks +101$" -- "$TF" run "$TMP/instants.yaml"

@@ -5,6 +5,7 @@
 #include <trackflow/output_path.hpp>
 #include <trackflow/plugin.hpp>
 #include <trackflow/run_result_codec.hpp>
+#include <trackflow/scan.hpp>
 #include <trackflow/tracks.hpp>
 
 #include <unistd.h>
@@ -31,6 +32,9 @@ constexpr const char* kHeader =
 
 // With an input of track sets (a tracker): each track's id and status, after the truth columns.
 constexpr const char* kTrackHeader = ",track_id,track_status";
+
+// With an input of scans: each detection's origin (a target id, clutter, or empty: unknown).
+constexpr const char* kOriginHeader = ",origin";
 
 // Opt-in (full_covariance): the upper triangle of the ENU covariance, row by row; units m2,
 // m2/s and m2/s2 (the sigma_* columns are the square roots of its diagonal).
@@ -67,7 +71,9 @@ struct PendingRow {
   double time = 0.0;
   int port = 0;
   std::uint32_t target = 0;
-  bool measurement = false;
+  bool measurement = false;        // a measurement or a scan's detection: no estimate columns
+  bool detection = false;          // a scan's detection: kind "detection", its origin written
+  std::uint32_t origin = kOriginUnknown;
   bool track = false;              // a tracker's track: its id and status are written
   std::uint64_t track_id = 0;
   TrackStatus status = TrackStatus::Tentative;
@@ -111,9 +117,11 @@ std::unique_ptr<TempFile> make_spill_file(const std::string& dir, const std::str
 // back this much at a time), ended by an empty chunk.
 constexpr std::size_t kChunkBytes = std::size_t{1} << 20;
 
-std::string column_name(int column, const std::vector<std::string>& annotation_columns, bool tracks, bool full_covariance) {
+std::string column_name(int column, const std::vector<std::string>& annotation_columns, bool tracks, bool scans,
+                        bool full_covariance) {
   std::string header = kHeader;
   if (tracks) header += kTrackHeader;
+  if (scans) header += kOriginHeader;
   if (full_covariance) header += kCovarianceHeader;
   for (const auto& a : annotation_columns) header += "," + a;
   int c = 0;
@@ -134,6 +142,7 @@ class CsvSink final : public Component, public RunResultCodec {
         path_where_(p.where("path")),
         node_(p.node()),
         include_measurements_(p.boolean("include_measurements")),
+        include_detections_(p.boolean("include_detections")),
         full_covariance_(p.boolean("full_covariance")),
         precision_(p.has("precision") ? static_cast<int>(p.integer("precision")) : csv::RowWriter::kShortest) {
     if (p.has("path") && path_.empty()) throw p.error("path", "must not be empty (leave it out for '<node id>.csv')");
@@ -159,10 +168,12 @@ class CsvSink final : public Component, public RunResultCodec {
     column_of_.clear();
     truth_input_ = false;
     tracks_input_ = false;
+    scans_input_ = false;
     for (const auto& in : inputs) {
       sources_.push_back(csv::quoted(in.node));
       truth_input_ |= (in.kinds & mask(ItemKind::Truth)) != 0;
       tracks_input_ |= (in.kinds & mask(ItemKind::Tracks)) != 0;
+      scans_input_ |= include_detections_ && (in.kinds & mask(ItemKind::Scan)) != 0;
       // One column per annotation that exists in the pipeline ("<adapter id>.<name>"), shared
       // by inputs that carry the same name.
       auto& columns = column_of_.emplace_back();
@@ -247,8 +258,32 @@ class CsvSink final : public Component, public RunResultCodec {
     flush(false);
   }
 
+  // One row per detection of the scan, kind "detection": its position in the frame, its origin,
+  // and the truth of its origin target (none for clutter or an unknown origin).
+  void on_scan(const Scan& s, int port) override {
+    if (!include_detections_) return;
+    for (const Detection& d : s.detections) {
+      if (d.value.size() < 3) continue;
+      to_measurement(s, d, detection_);
+      PendingRow& r = add_measurement_row(detection_, port);
+      r.detection = true;
+      r.origin = d.origin;
+      r.target = d.origin;
+    }
+    arrived(s.time);
+    flush(false);
+  }
+
   void on_measurement(const Measurement& m, int port) override {
     if (!include_measurements_ || !m.valid || m.value.size() < 3) return;
+    add_measurement_row(m, port);
+    arrived(m.time);
+    flush(false);
+  }
+
+  // A measurement's cells: the Cartesian position (a spherical one converted) and, when
+  // Cartesian, the sigmas of its covariance diagonal.
+  PendingRow& add_measurement_row(const Measurement& m, int port) {
     PendingRow& r = pending_.emplace_back();
     r.time = m.time;
     r.port = port;
@@ -266,8 +301,7 @@ class CsvSink final : public Component, public RunResultCodec {
     } else {
       r.value.head<3>() = measured_position(m);
     }
-    arrived(m.time);
-    flush(false);
+    return r;
   }
 
   std::unique_ptr<RunResult> end_run() override {
@@ -405,6 +439,7 @@ class CsvSink final : public Component, public RunResultCodec {
                         path_where_, node_);
     std::string header = kHeader;
     if (tracks_input_) header += kTrackHeader;
+    if (scans_input_) header += kOriginHeader;
     if (full_covariance_) header += kCovarianceHeader;
     for (const auto& name : annotation_columns_) header += ',' + csv::quoted(name);
     header += '\n';
@@ -507,7 +542,7 @@ class CsvSink final : public Component, public RunResultCodec {
     } else {
       w.text("input" + std::to_string(r.port));  // set_inputs was not called (direct use)
     }
-    w.text(r.measurement ? "measurement" : r.track ? "track" : "estimate");
+    w.text(r.detection ? "detection" : r.measurement ? "measurement" : r.track ? "track" : "estimate");
     if (r.measurement)
       w.empty();
     else
@@ -516,7 +551,9 @@ class CsvSink final : public Component, public RunResultCodec {
     for (int i = 0; i < 6; ++i)
       w.real_if(r.has_sigma && (i < 3 || r.has_velocity) && !(r.sigma_missing & (1u << i)), r.sigma(i));
     w.real_if(!r.measurement && r.has_nis, r.nis);
-    const Truth* t = truth_at(r.time, r.target, !r.measurement, r.track);
+    // A detection's truth is its origin target's only (clutter and unknown origins have none).
+    const Truth* t = r.detection ? (r.origin < kOriginClutter ? truth_at(r.time, r.target, true, true) : nullptr)
+                                 : truth_at(r.time, r.target, !r.measurement, r.track);
     Vec6 truth = Vec6::Zero();
     if (t) truth << t->position, t->velocity;
     double nees = 0.0;
@@ -539,6 +576,14 @@ class CsvSink final : public Component, public RunResultCodec {
         w.empty();
       }
     }
+    if (scans_input_) {
+      if (r.detection && r.origin == kOriginClutter)
+        w.text("clutter");
+      else if (r.detection && r.origin != kOriginUnknown)
+        w.integer(r.origin);
+      else
+        w.empty();
+    }
     std::fill(row_annotations_.begin(), row_annotations_.end(), std::numeric_limits<double>::quiet_NaN());
     if (!r.measurement && r.port >= 0 && static_cast<size_t>(r.port) < column_of_.size()) {
       const auto& columns = column_of_[static_cast<size_t>(r.port)];
@@ -555,7 +600,7 @@ class CsvSink final : public Component, public RunResultCodec {
     if (w.non_finite()) {
       if (non_finite_ == 0) {
         first_non_finite_ = "run " + std::to_string(run_) + ", t=" + number_text::general(r.time, 10) + " s, column " +
-                            column_name(w.first_non_finite_column(), annotation_columns_, tracks_input_, full_covariance_);
+                            column_name(w.first_non_finite_column(), annotation_columns_, tracks_input_, scans_input_, full_covariance_);
       }
       non_finite_ += static_cast<std::uint64_t>(w.non_finite());
     }
@@ -565,6 +610,7 @@ class CsvSink final : public Component, public RunResultCodec {
   const SourceLoc path_where_;
   const std::string node_;
   const bool include_measurements_;
+  const bool include_detections_;  // rows for the detections of scan inputs (a scenario's truth input also carries scans)
   const bool full_covariance_;
   const int precision_;  // csv::RowWriter::kShortest unless given
   std::vector<std::string> sources_;
@@ -573,6 +619,8 @@ class CsvSink final : public Component, public RunResultCodec {
   std::vector<double> row_annotations_;      // scratch of one row, sized once
   bool truth_input_ = true;  // until set_inputs says otherwise, rows wait for truth
   bool tracks_input_ = false;  // an input of track sets: the track_id and track_status columns
+  bool scans_input_ = false;   // an input of scans: the origin column
+  Measurement detection_;      // a scan's detection as a measurement (its position), reused
   // Per run.
   std::uint64_t run_ = 0;
   std::vector<Truth> truth_;  // time-sorted
@@ -599,7 +647,8 @@ void register_components(Registrar& r) {
   ComponentDecl d;
   d.type = "sink.csv";
   d.kind = ComponentKind::Sink;
-  d.summary = "Writes estimates (any number of filters), optional measurements and matching truth of all runs to one CSV file";
+  d.summary = "Writes estimates (any number of filters), track sets, scans' detections, optional measurements and matching "
+              "truth of all runs to one CSV file";
   d.doc =
       "Columns: run,time,source,kind,updated,x,y,z,vx,vy,vz,sigma_x..sigma_vz,nis,nees,truth_x..truth_vz"
       "[,cov_x_x,cov_x_y,...,cov_vz_vz], then one column per annotation the pipeline's adapters publish on the "
@@ -608,7 +657,9 @@ void register_components(Registrar& r) {
       "adapter has published none yet. source is the upstream node id; kind is estimate, measurement or track. "
       "With an input of track sets (a tracker), two more columns follow the truth: track_id and track_status "
       "(tentative, confirmed, coasting, deleted: a deleted track's last state, once), one row per track per set; "
-      "a track's truth is that of its target (the origin of its initiating detections) only. Truth "
+      "a track's truth is that of its target (the origin of its initiating detections) only. With include_detections: true and an input of scans, "
+      "one row per detection, kind detection, its position in the frame (spherical ones converted), its truth that of "
+      "its origin target only, and one more column, origin: the target id, clutter, or empty when unknown. Truth "
       "columns and nees are filled when a truth sample lies within 1 us of the row's time, nis when the estimate "
       "was updated; missing values are empty cells, and a value that is NaN or infinite is written as nan, inf or -inf "
       "and fails the run (exit 2). The file is streamed in run order while the ensemble runs (written as <file>.partial, "
@@ -622,6 +673,7 @@ void register_components(Registrar& r) {
       ParamSpec::string("path", "output file relative to --out (default: <node id>.csv); absolute paths and '..' are "
                                 "refused unless the command line has --allow-outside-out"),
       ParamSpec::boolean("include_measurements", "also write measurement rows").def("false"),
+      ParamSpec::boolean("include_detections", "also write a row per detection of the scan inputs (and the origin column)").def("false"),
       ParamSpec::boolean("full_covariance",
                          "also write the upper triangle of the ENU covariance (cov_x_x ... cov_vz_vz; m2, m2/s, m2/s2)")
           .def("false"),
@@ -630,7 +682,7 @@ void register_components(Registrar& r) {
           .at_least(1)
           .at_most(17),
   };
-  d.accepts = ItemKind::Estimate | ItemKind::Truth | mask(ItemKind::Measurement) | mask(ItemKind::Tracks);
+  d.accepts = ItemKind::Estimate | ItemKind::Truth | mask(ItemKind::Measurement) | mask(ItemKind::Tracks) | mask(ItemKind::Scan);
   d.min_inputs = 1;
   d.max_inputs = -1;
   d.produces = 0;

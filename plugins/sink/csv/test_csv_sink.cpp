@@ -655,3 +655,48 @@ TEST_CASE("track sets: a row per track, id, status, own target truth") {
   CHECK(rows[2][TX].empty());  // unknown origin: no truth is claimed
   CHECK(rows[2][Nees].empty());
 }
+
+// A scan: one row per detection, kind detection, its position, its origin column, and the truth of
+// its origin target only (clutter has none).
+TEST_CASE("scans: a row per detection with origin and target truth") {
+  const InputInfo radar{"scenario", "sim.scenario", mask(ItemKind::Scan)};
+  const InputInfo scenario{"scenario", "sim.scenario", mask(ItemKind::Truth)};
+  auto c = make_csv("{include_detections: true}", {radar, scenario});
+  c->start_run({0, 1, nullptr});
+  Truth a = truth(2.0, Vec3(10, 20, 0), Vec3(1, 0, 0));
+  a.target = 3;
+  c->on_truth(a, 1);
+  std::vector<Detection> d(2);
+  for (auto& x : d) {
+    x.value.resize(3);
+    x.covariance = MeasCov::Identity(3, 3) * 4.0;
+  }
+  d[0].value << 11, 19, 0;
+  d[0].origin = 3;
+  d[1].value << -50, 70, 1;
+  d[1].origin = kOriginClutter;
+  Scan s;
+  s.time = 2.0;
+  s.sensor.frame = Frame::Cartesian;
+  s.detections = d;
+  c->on_scan(s, 0);
+  const auto rows = finished_rows(*c, scratch("scans"));
+  REQUIRE(rows.size() == 3);
+  REQUIRE(rows[0].size() == 26);
+  CHECK(rows[0][25] == "origin");
+  CHECK(rows[1][Kind] == "detection");
+  CHECK(num(rows[1][X]) == 11.0);
+  CHECK(num(rows[1][TX]) == 10.0);
+  CHECK(rows[1][25] == "3");
+  CHECK(rows[1][Nees].empty());
+  CHECK(rows[2][25] == "clutter");
+  CHECK(rows[2][TX].empty());
+  // Off by default: a scenario wired for its truth also delivers its scans, which then write nothing.
+  auto plain = make_csv("{}", {radar, scenario});
+  plain->start_run({0, 1, nullptr});
+  plain->on_truth(a, 1);
+  plain->on_scan(s, 0);
+  const auto none = finished_rows(*plain, scratch("scans_off"));
+  REQUIRE(none.size() == 1);
+  CHECK(none[0].size() == 25);
+}
