@@ -3,6 +3,7 @@
 
 #include <trackflow/host/plugin_fixture_state.hpp>
 #include <trackflow/testing/plugin_fixture.hpp>
+#include <trackflow/tracker.hpp>
 
 #include <memory>
 #include <string>
@@ -26,6 +27,15 @@ inline std::shared_ptr<Component> make(const std::string& type, const std::strin
 }
 inline Params params_for(const std::string& type, const std::string& yaml_params, const std::string& node_id = "node") {
   return fixture().params_for(type, yaml_params, node_id);
+}
+
+// A tracker part (an associator, initiator or deleter) of `type` made from YAML parameters, as a
+// tracker makes the part it names; null when `type` makes a part of another kind.
+template <class Part>
+std::unique_ptr<Part> make_part(const std::string& type, const std::string& yaml_params) {
+  const Params p = params_for(type, yaml_params);
+  std::unique_ptr<TrackerPart> part = registry().find(type)->decl.create_part(p);
+  return std::unique_ptr<Part>(dynamic_cast<Part*>(part.release()));
 }
 
 }  // namespace trackflow::test

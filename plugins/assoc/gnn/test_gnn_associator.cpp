@@ -17,11 +17,7 @@ using namespace trackflow;
 
 namespace {
 
-std::unique_ptr<Associator> gnn(const std::string& yaml) {
-  const Params p = test::params_for("assoc.gnn", yaml);
-  std::unique_ptr<TrackerPart> part = test::registry().find("assoc.gnn")->decl.create_part(p);
-  return std::unique_ptr<Associator>(dynamic_cast<Associator*>(part.release()));
-}
+std::unique_ptr<Associator> gnn(const std::string& yaml) { return test::make_part<Associator>("assoc.gnn", yaml); }
 
 struct Problem {
   std::vector<PredictedMeasurement> predicted;

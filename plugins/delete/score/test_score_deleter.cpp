@@ -19,11 +19,7 @@ using namespace trackflow;
 
 namespace {
 
-std::unique_ptr<Deleter> deleter(const std::string& yaml) {
-  const Params p = test::params_for("delete.score", yaml);
-  std::unique_ptr<TrackerPart> part = test::registry().find("delete.score")->decl.create_part(p);
-  return std::unique_ptr<Deleter>(dynamic_cast<Deleter*>(part.release()));
-}
+std::unique_ptr<Deleter> deleter(const std::string& yaml) { return test::make_part<Deleter>("delete.score", yaml); }
 
 struct SetCollector : Component {
   std::vector<std::vector<TrackEstimate>> sets;

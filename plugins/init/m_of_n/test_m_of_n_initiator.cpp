@@ -17,11 +17,7 @@ using namespace trackflow;
 
 namespace {
 
-std::unique_ptr<Initiator> initiator(const std::string& yaml) {
-  const Params p = test::params_for("init.m_of_n", yaml);
-  std::unique_ptr<TrackerPart> part = test::registry().find("init.m_of_n")->decl.create_part(p);
-  return std::unique_ptr<Initiator>(dynamic_cast<Initiator*>(part.release()));
-}
+std::unique_ptr<Initiator> initiator(const std::string& yaml) { return test::make_part<Initiator>("init.m_of_n", yaml); }
 
 struct OwnedScan {
   std::vector<Detection> detections;

@@ -19,11 +19,7 @@ using namespace trackflow;
 
 namespace {
 
-std::unique_ptr<Initiator> initiator(const std::string& yaml) {
-  const Params p = test::params_for("init.score", yaml);
-  std::unique_ptr<TrackerPart> part = test::registry().find("init.score")->decl.create_part(p);
-  return std::unique_ptr<Initiator>(dynamic_cast<Initiator*>(part.release()));
-}
+std::unique_ptr<Initiator> initiator(const std::string& yaml) { return test::make_part<Initiator>("init.score", yaml); }
 
 struct SetCollector : Component {
   std::vector<std::vector<TrackEstimate>> sets;
