@@ -23,7 +23,7 @@ using namespace trackflow;
 class AlphaBetaEstimator final : public Estimator {
  public:
   explicit AlphaBetaEstimator(alpha_beta::Gains gains)
-      : Estimator(MeasurementSpec{Frame::Cartesian, RangeRateUse::Ignore, {}}), gains_(gains) {}
+      : Estimator(MeasurementSpec{mask(Frame::Cartesian), RangeRateUse::Ignore, {}}), gains_(gains) {}
 
   std::unique_ptr<Estimator> clone() const override { return std::make_unique<AlphaBetaEstimator>(*this); }
 

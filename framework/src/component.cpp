@@ -27,7 +27,22 @@ const char* to_string(ItemKind k) {
   return "?";
 }
 
-const char* to_string(Frame f) { return f == Frame::Spherical ? "spherical" : "cartesian"; }
+const char* to_string(Frame f) {
+  switch (f) {
+    case Frame::Spherical: return "spherical";
+    case Frame::Cartesian: return "cartesian";
+    case Frame::Polar: return "polar (range-azimuth)";
+    case Frame::Planar: return "planar (x-y)";
+  }
+  return "unknown";
+}
+
+std::string frame_names(FrameMask m) {
+  std::string out;
+  for (Frame f : kFrames)
+    if (m & mask(f)) out += (out.empty() ? "" : "/") + std::string(to_string(f));
+  return out.empty() ? "no" : out;
+}
 
 const char* to_string(ComponentKind k) {
   switch (k) {

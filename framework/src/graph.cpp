@@ -219,13 +219,6 @@ Graph build_graph(PipelineConfig cfg, const PluginRegistry& registry) {
 
 namespace {
 
-std::string frames(FrameMask m) {
-  std::vector<std::string> f;
-  for (Frame i : {Frame::Spherical, Frame::Cartesian})
-    if (m & mask(i)) f.push_back(to_string(i));
-  return f.empty() ? "no" : join(f, "/");
-}
-
 // The converters that turn measurements into Cartesian ones (not, e.g., a spherical corrector).
 std::vector<std::string> converter_types(const PluginRegistry& registry) {
   std::vector<std::string> out;
@@ -251,8 +244,8 @@ void check_frames(const Graph& g, const GraphInstance& inst, const PluginRegistr
         hint = "; insert a converter between them (" + join(converter_types(registry)) + ")";
       else if (d.accepts_frames & mask(Frame::Spherical))
         hint = "; wire it to the radar's spherical output instead";
-      throw ConfigError("input '" + up.config.id + "' (" + up.config.type + ") produces " + frames(produced) +
-                            " measurements, but " + n.config.type + " takes " + frames(d.accepts_frames) +
+      throw ConfigError("input '" + up.config.id + "' (" + up.config.type + ") produces " + frame_names(produced) +
+                            " measurements, but " + n.config.type + " takes " + frame_names(d.accepts_frames) +
                             " measurements" + hint,
                         n.config.input_locs[k], n.config.id);
     }
@@ -356,6 +349,23 @@ GraphInstance instantiate_checked(const Graph& g, const PluginRegistry& registry
     const std::string& fid = g.nodes[n.attach_to].config.id;
     if (!adapter || !filter)
       throw ConfigError("cannot attach: " + n.config.type + " is not an Adapter or its target is not a Filter",
+                        n.config.attach_loc, n.config.id);
+    // The measurement frames the filter receives (its measurement wires), each of which the adapter
+    // must understand: a 2-D frame reaching an adapter written for 3 values is refused here.
+    const GraphNode& fn = g.nodes[n.attach_to];
+    // An input that may produce any frame is checked at run time by the filter, not here.
+    FrameMask incoming = 0;
+    bool known = true;
+    for (size_t k = 0; k < fn.inputs.size(); ++k)
+      if (fn.input_kinds[k] & mask(ItemKind::Measurement)) {
+        const FrameMask f = g.nodes[fn.inputs[k]].type->decl.produces_frames & inst.components[fn.inputs[k]]->produced_frames();
+        known = known && f != kAnyFrame;
+        incoming |= f;
+      }
+    if (const FrameMask refused = incoming & ~n.type->decl.accepts_frames; known && refused != 0)
+      throw ConfigError("cannot attach adapter '" + n.config.id + "' (" + n.config.type + ") to filter '" + fid +
+                            "': the filter receives " + frame_names(refused) + " measurements and " + n.config.type +
+                            " takes " + frame_names(n.type->decl.accepts_frames) + " ones",
                         n.config.attach_loc, n.config.id);
     const NoiseNeeds needs = adapter->needs();
     if (std::string why = noise_mismatch(needs, filter->noise(), filter->has_covariance_access()); !why.empty())

@@ -24,7 +24,9 @@ struct Summary;
 // What an estimator measures with; the host checks each detection against it before the
 // estimator sees one (frame, number of values, range rate, a tilted sensor).
 struct MeasurementSpec {
-  Frame frame = Frame::Spherical;
+  // The frames it takes (a mask of Frame bits, e.g. Spherical | Polar): a detection of another
+  // frame is refused before the estimator sees it.
+  FrameMask frames = mask(Frame::Spherical);
   // Spherical estimators: use the range rate when present (Auto), always (Use) or never (Ignore).
   // Cartesian estimators take the three position values: Ignore.
   RangeRateUse range_rate = RangeRateUse::Ignore;
@@ -81,9 +83,9 @@ inline bool set_log_det(PredictedMeasurement& p) {
 // track restarts), initiate() with usable measurements until it returns true, then predict(T)
 // (T > 0 s) and update() per measurement, fill() when the estimate is published. A measurement is
 // one detection with its sensor frame and time (items.hpp); a tracker assembles one per detection
-// it assigns. Measurements reach the estimator valid, finite, in its frame and of the declared
-// dimension `dim` (3, or 4 with range rate); R_ holds the detection's covariance, or what an adapter
-// put there. A concrete estimator should be `final`: the single-track node then calls it without a
+// it assigns. Measurements reach the estimator valid, finite, in one of its frames and of the
+// declared dimension `dim` (position_values(frame): 3, or 2 for Polar and Planar; one more with
+// range rate); R_ holds the detection's covariance, or what an adapter put there. A concrete estimator should be `final`: the single-track node then calls it without a
 // virtual call.
 class Estimator {
  public:
@@ -184,13 +186,13 @@ class Estimator {
     Measurement m;
     static_cast<SensorFrame&>(m) = s;
     m.time = time();
-    m.has_range_rate = dim == 4;
+    m.has_range_rate = dim == position_values(s.frame) + 1;
     m.value = MeasVec::Zero(dim);
     m.covariance = R;
     copy.measurement_noise() = R;
     if (!static_cast<Estimator&>(copy).update(m, dim) || !innovation.updated || innovation.innovation.size() != dim) return false;
     p.z = -innovation.innovation;
-    if (s.frame == Frame::Spherical) p.z(1) = wrap_angle(p.z(1));
+    wrap_residual(s.frame, p.z);
     p.S = innovation.innovation_covariance;
     return set_log_det(p);
   }

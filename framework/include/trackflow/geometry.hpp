@@ -70,10 +70,40 @@ inline Vec3 frame_to_sensor(const Measurement& m, const Vec3& v) {
   return m.sensor_level ? v : Vec3(m.sensor_axes.transpose() * v);
 }
 
-// A spherical measurement's position in the frame: sensor position plus the converted offset,
-// turned into the frame's axes when the sensor is tilted.
+// The elevation a detection's position is taken at: its own, or 0 for a 2-D radar (Polar), whose
+// target is placed in the radar's horizontal plane (ground range = measured range).
+inline double measured_elevation(const Measurement& m) { return m.frame == Frame::Polar ? 0.0 : m.value(2); }
+
+// A measurement's position in the frame. Spherical and Polar: sensor position plus the converted
+// offset, turned into the frame's axes when the sensor is tilted; Cartesian as it is; Planar in the
+// plane z = 0.
 inline Vec3 measured_position(const Measurement& m) {
-  return sensor_to_frame(m, spherical_to_enu(m.value(0), m.value(1), m.value(2), m.azimuth)) + m.sensor_position;
+  switch (m.frame) {
+    case Frame::Cartesian: return m.value.head<3>();
+    case Frame::Planar: return Vec3(m.value(0), m.value(1), 0.0);
+    default:
+      return sensor_to_frame(m, spherical_to_enu(m.value(0), m.value(1), measured_elevation(m), m.azimuth)) +
+             m.sensor_position;
+  }
+}
+
+// The covariance of measured_position from the measurement's position covariance: J R J' (the
+// exact first-order transform) for Spherical and Polar, R for Cartesian; a 2-D frame's position
+// has zero variance in the direction it does not measure (z, or the radar's vertical).
+inline Mat3 measured_position_covariance(const Measurement& m, const MeasCov& R) {
+  const int k = position_values(m.frame);
+  Mat3 Rp = Mat3::Zero();
+  Rp.topLeftCorner(k, k) = R.topLeftCorner(k, k);
+  if (m.frame == Frame::Cartesian || m.frame == Frame::Planar) return Rp;
+  Mat3 J = spherical_to_enu_jacobian(m.value(0), m.value(1), measured_elevation(m), m.azimuth);
+  if (!m.sensor_level) J = m.sensor_axes * J;
+  return J * Rp * J.transpose();
+}
+
+// nu = z - h with the azimuth difference wrapped to (-pi, pi] in the frames that have one: the
+// one place a residual learns its frame's manifold.
+inline void wrap_residual(Frame f, MeasVec& nu) {
+  if (has_azimuth(f)) nu(1) = wrap_angle(nu(1));
 }
 
 // The text of the error a consumer that works in the frame's axes gives for a tilted sensor

@@ -4,6 +4,7 @@
 #include <Eigen/Core>
 #include <cstdint>
 #include <cstring>
+#include <string>
 
 namespace trackflow {
 
@@ -44,12 +45,24 @@ struct Truth {
 
 // Spherical: value = [range, azimuth, elevation(, range_rate)].
 // Cartesian: value = [x, y, z(, range_rate)] in the ENU frame (origin included).
-enum class Frame : std::uint8_t { Spherical = 1, Cartesian = 2 };
+// Polar: value = [range, azimuth(, range_rate)], a 2-D surveillance radar (no elevation).
+// Planar: value = [x, y] in the ENU frame, a position sensor of the plane z = 0.
+// The values are bits, so a FrameMask names several and a Frame is the mask of itself.
+enum class Frame : std::uint8_t { Spherical = 1, Cartesian = 2, Polar = 4, Planar = 8 };
 // The measurement frames a component accepts or produces (ComponentDecl), as a bit mask.
 using FrameMask = std::uint8_t;
 constexpr FrameMask mask(Frame f) { return static_cast<FrameMask>(f); }
 inline constexpr FrameMask kAnyFrame = 0xFF;
+inline constexpr Frame kFrames[] = {Frame::Spherical, Frame::Cartesian, Frame::Polar, Frame::Planar};
 const char* to_string(Frame f);
+// The frames of a mask for messages: "spherical/cartesian", or "no".
+std::string frame_names(FrameMask m);
+
+// How many position values a detection of frame f has before its optional range rate: 3, or 2
+// for the 2-D frames (Polar, Planar).
+constexpr int position_values(Frame f) { return f == Frame::Polar || f == Frame::Planar ? 2 : 3; }
+// Whether value(1) is an azimuth (Spherical, Polar): residuals against it are wrapped.
+constexpr bool has_azimuth(Frame f) { return f == Frame::Spherical || f == Frame::Polar; }
 
 // north_clockwise: compass bearing, x = r cos(el) sin(az), y = r cos(el) cos(az).
 // x_counterclockwise: mathematical angle from x (east) toward y (north).
@@ -97,7 +110,7 @@ struct Measurement : SensorFrame, Detection {
   double time = 0.0;
   bool valid = true;  // false: radar not locked / data flagged; filters coast
 
-  int position_dim() const { return 3; }
+  int position_dim() const { return position_values(frame); }
 };
 
 // Names and units of a filter's state components, in the order of Estimate::state.

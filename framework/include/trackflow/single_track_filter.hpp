@@ -104,8 +104,8 @@ class SingleTrackFilter final : public Filter, public FieldListCodec<SingleTrack
   void on_measurement(const Measurement& m, int port) override {
     const MeasurementSpec& spec = est().measurement_spec();
     const int n = static_cast<int>(m.value.size());
-    const bool well_formed =
-        m.frame == spec.frame && n == (m.has_range_rate ? 4 : 3) && m.covariance.rows() == n && m.covariance.cols() == n;
+    const bool well_formed = (spec.frames & mask(m.frame)) && n == position_values(m.frame) + (m.has_range_rate ? 1 : 0) &&
+                             m.covariance.rows() == n && m.covariance.cols() == n;
     // An invalid measurement (radar not locked) is coasted through whatever it holds: a converter
     // passes it on unconverted, so neither its frame nor its shape is checked.
     if (m.valid) check_valid(m, n, well_formed);
@@ -251,17 +251,21 @@ class SingleTrackFilter final : public Filter, public FieldListCodec<SingleTrack
   void check_valid(const Measurement& m, int n, bool well_formed) {
     const MeasurementSpec& spec = est().measurement_spec();
     const std::string& who = TrackContext::who;
-    if (m.frame != spec.frame)
-      throw DataError(who + " takes " + to_string(spec.frame) + " measurements, but the one at t=" +
+    if (!(spec.frames & mask(m.frame)))
+      throw DataError(who + " takes " + frame_names(spec.frames) + " measurements, but the one at t=" +
                       std::to_string(m.time) + " s is " + to_string(m.frame) +
-                      (spec.frame == Frame::Cartesian
+                      ((spec.frames & mask(Frame::Cartesian)) && m.frame == Frame::Spherical
                            ? "; put a convert.* node between the radar and it"
-                           : "; for Cartesian (converted) measurements use filter.kalman or filter.decoupled"));
-    if (!well_formed)
-      throw DataError(who + ": measurement at t=" + std::to_string(m.time) + " s has " + std::to_string(n) +
-                      " values and a " + std::to_string(m.covariance.rows()) + "x" +
-                      std::to_string(m.covariance.cols()) + " covariance; expected " +
-                      (m.has_range_rate ? "4 (with range rate)" : "3") + " values and a matching covariance");
+                           : (spec.frames & mask(Frame::Spherical)) && m.frame == Frame::Cartesian
+                                 ? "; for Cartesian (converted) measurements use filter.kalman or filter.decoupled"
+                                 : ""));
+    if (!well_formed) {
+      const int expected = position_values(m.frame) + (m.has_range_rate ? 1 : 0);
+      throw DataError(who + ": " + to_string(m.frame) + " measurement at t=" + std::to_string(m.time) + " s has " +
+                      std::to_string(n) + " values and a " + std::to_string(m.covariance.rows()) + "x" +
+                      std::to_string(m.covariance.cols()) + " covariance; expected " + std::to_string(expected) +
+                      (m.has_range_rate ? " (with range rate)" : "") + " values and a matching covariance");
+    }
     if (spec.range_rate == RangeRateUse::Use && !m.has_range_rate)
       throw DataError(who + ": range_rate: use, but the measurement at t=" + std::to_string(m.time) +
                       " s has no range rate (range_rate: auto accepts both)");
@@ -269,19 +273,22 @@ class SingleTrackFilter final : public Filter, public FieldListCodec<SingleTrack
     est().check(m);
   }
 
-  // The measurement's R (3x3 or 4x4) and the finiteness of what the update will use, as
+  // The measurement's R (2x2 to 4x4) and the finiteness of what the update will use, as
   // fixed-size copies and checks (the items are sized at run time).
   static void copy_R(const Measurement& m, int dim, MeasCov& R) {
     R.resize(dim, dim);
     if (dim == 4)
       R.template topLeftCorner<4, 4>() = m.covariance.template topLeftCorner<4, 4>();
-    else
+    else if (dim == 3)
       R.template topLeftCorner<3, 3>() = m.covariance.template topLeftCorner<3, 3>();
+    else
+      R.template topLeftCorner<2, 2>() = m.covariance.template topLeftCorner<2, 2>();
   }
   static bool finite(const Measurement& m, int dim, const MeasCov& R) {
     if (m.value.size() < dim || R.rows() < dim || R.cols() < dim) return false;
     if (dim == 4) return finite_block<4, 1>(m.value) && finite_block<4, 4>(R);
-    return finite_block<3, 1>(m.value) && finite_block<3, 3>(R);
+    if (dim == 3) return finite_block<3, 1>(m.value) && finite_block<3, 3>(R);
+    return finite_block<2, 1>(m.value) && finite_block<2, 2>(R);
   }
   // Whether the leading Rows x Cols block of `a` is finite, element by element: x * 0 is 0 for a
   // finite x and NaN for an infinity or a NaN, so the products sum to 0 exactly when all are
@@ -296,12 +303,13 @@ class SingleTrackFilter final : public Filter, public FieldListCodec<SingleTrack
   }
 
   int dimension(const Measurement& m) const {
+    const int positions = position_values(m.frame);
     switch (est().measurement_spec().range_rate) {
-      case RangeRateUse::Use: return 4;
-      case RangeRateUse::Auto: return m.has_range_rate ? 4 : 3;
+      case RangeRateUse::Use: return positions + 1;
+      case RangeRateUse::Auto: return m.has_range_rate ? positions + 1 : positions;
       case RangeRateUse::Ignore: break;
     }
-    return 3;
+    return positions;
   }
 
   // The track's estimates carry the truth target of its first usable measurement with a known

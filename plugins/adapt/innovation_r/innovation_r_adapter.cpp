@@ -238,6 +238,8 @@ void register_components(Registrar& r) {
   ComponentDecl d;
   d.type = "adapt.innovation_r";
   d.kind = ComponentKind::Adapter;
+  // Its channels are three position values (2-D measurements are refused when the pipeline is built).
+  d.accepts_frames = mask(Frame::Cartesian) | mask(Frame::Spherical);
   d.summary = "Adaptive measurement noise R from post-update residuals with a moving-average window (paper 001)";
   d.doc = kDoc;
   d.accepts = 0;

@@ -323,6 +323,8 @@ void register_components(Registrar& r) {
   ComponentDecl d;
   d.type = "adapt.quality_switch";
   d.kind = ComponentKind::Adapter;
+  // Its channels are three position values (2-D measurements are refused when the pipeline is built).
+  d.accepts_frames = mask(Frame::Spherical);
   d.summary = "Quality-switching adaptive q and R: BEST/NORMAL/WORST per channel from the RMS of successive "
               "measurement differences, beacon/skin tables (paper 000)";
   d.doc = kDoc;

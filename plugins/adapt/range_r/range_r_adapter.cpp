@@ -121,6 +121,8 @@ void register_components(Registrar& r) {
   ComponentDecl d;
   d.type = "adapt.range_r";
   d.kind = ComponentKind::Adapter;
+  // Its channels are three position values (2-D measurements are refused when the pipeline is built).
+  d.accepts_frames = mask(Frame::Spherical);
   d.summary = "Range-dependent angle noise R(r) = thermal part (grows with range) + glint part (shrinks), paper 003";
   d.doc = kDoc;
   d.accepts = 0;

@@ -29,7 +29,7 @@ class DecoupledEstimator final : public Estimator {
 
  public:
   explicit DecoupledEstimator(DecoupledSettings s)
-      : Estimator(MeasurementSpec{Frame::Cartesian, RangeRateUse::Ignore, {}}),
+      : Estimator(MeasurementSpec{mask(Frame::Cartesian), RangeRateUse::Ignore, {}}),
         s_(std::move(s)) {
     for (int a = 0; a < 3; ++a) {
       idx_[a] = decoupled::pos(a);

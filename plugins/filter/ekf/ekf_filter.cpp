@@ -1,5 +1,6 @@
-// Purpose: filter.ekf — extended Kalman filter with a Cartesian ENU state (CV, CA or Singer motion) on spherical [r, az, el(, rdot)] measurements.
+// Purpose: filter.ekf — extended Kalman filter with a Cartesian ENU state (CV, CA or Singer motion) on spherical [r, az, el(, rdot)] or 2-D radar [r, az(, rdot)] measurements.
 #include "estimation/cartesian_radar_estimator.hpp"
+#include "estimation/ekf_polar_update.hpp"
 #include "estimation/ekf_radar_update.hpp"
 
 #include <trackflow/geometry.hpp>
@@ -29,6 +30,7 @@ class ExtendedKalmanFilter final
   explicit ExtendedKalmanFilter(cartesian_filter::Settings s) : Base(std::move(s)) {}
 
   static std::vector<std::string> counter_names() { return {"azimuth_dropped", "azimuth_deweighted"}; }
+  static constexpr FrameMask kFrames = mask(Frame::Spherical) | mask(Frame::Polar);
 
  private:
   enum Counter { kAzimuthDropped, kAzimuthDeweighted };
@@ -44,6 +46,18 @@ class ExtendedKalmanFilter final
     const bool curvature = this->settings().zenith == cartesian_filter::Settings::Zenith::Curvature;
     const cartesian_filter::EkfOutcome outcome = cartesian_filter::ekf_radar_update<N, M>(
         x_, P_, idx_, m, Eigen::Matrix<double, M, M>(R_.template topLeftCorner<M, M>()), curvature, in);
+    return report<M>(m, outcome, in);
+  }
+  // A 2-D radar's [r, az(, rdot)]: M = 2 or 3 (ekf_polar_update.hpp).
+  template <int M>
+  bool correct_polar(const Measurement& m) {
+    cartesian_filter::EkfInnovation<M> in;
+    const cartesian_filter::EkfOutcome outcome = cartesian_filter::ekf_polar_update<N, M>(
+        x_, P_, idx_, m, Eigen::Matrix<double, M, M>(R_.template topLeftCorner<M, M>()), in);
+    return report<M>(m, outcome, in);
+  }
+  template <int M>
+  bool report(const Measurement& m, cartesian_filter::EkfOutcome outcome, const cartesian_filter::EkfInnovation<M>& in) {
     if (outcome == cartesian_filter::EkfOutcome::AtSensor) {
       this->warn("predicted position at the sensor at t=" + std::to_string(m.time) +
                  " s: no direction to linearise about; measurement not used");
@@ -93,7 +107,7 @@ void register_components(Registrar& r) {
   d.type = "filter.ekf";
   d.kind = ComponentKind::Filter;
   d.summary = "Extended Kalman filter: Cartesian ENU state (CV, CA or Singer) on spherical [r, az, el(, rdot)] "
-              "measurements";
+              "or 2-D radar [r, az(, rdot)] measurements";
   d.doc =
       "State [x vx (ax) y vy (ay) z vz (az)] in ENU; linear prediction, measurement h(x) = [r, az, el(, rdot)] "
       "relative to the (stationary) sensor in its azimuth convention, analytic Jacobian (paper 000 eq 3.22-3.24, "
@@ -103,14 +117,18 @@ void register_components(Registrar& r) {
       "added to R and the azimuth is dropped while the zenith is within 3 sigma (zenith: curvature; zenith: textbook "
       "is the plain EKF); dropped and de-weighted azimuths are counted in the summary. Invalid measurements: predict "
       "only. "
-      "R from each measurement in spherical space (adapters may replace it; q per ENU axis)."
+      "R from each measurement in spherical space (adapters may replace it; q per ENU axis). A 2-D surveillance "
+      "radar's polar [r, az(, rdot)] measurements: h is the same model's range, azimuth (and range-rate) rows; a "
+      "track started from polar points lies in the radar's horizontal plane (z at the radar's height with zero "
+      "variance, no z process noise: the predicted range is the ground range); no curvature conditioning, the "
+      "azimuth is dropped only straight above the radar; level radars only."
       " Several inputs (up to 8 radars, each at its own site with its own noise, rate and biases): the measurements are used one after another in time order, equal time stamps in the engine's delivery order (the order of the radars' declaration when they share a truth source); a tilted sensor (a geodetic site away from the frame's origin) is measured in its own axes; the summary then gives updates.<input> and nis_mean.<input> (mean NIS per element with its 95 % chi-square band) per sensor. See docs/filters.md.";
   d.accepts = mask(ItemKind::Measurement);
   // Several radars into one track: one input per sensor (docs/filters.md, "Several sensors").
   d.min_inputs = 1;
   d.max_inputs = SingleTrackRunResult::kMaxPorts;
   d.produces = mask(ItemKind::Estimate);
-  d.accepts_frames = mask(Frame::Spherical);
+  d.accepts_frames = mask(Frame::Spherical) | mask(Frame::Polar);
   d.params = cartesian_filter::param_specs();
   d.params.push_back(cartesian_filter::zenith_param());
   d.create = create;

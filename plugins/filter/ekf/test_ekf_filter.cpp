@@ -26,10 +26,12 @@ struct ReferenceEkf {
   Eigen::VectorXd x;  // [x vx y vy z vz]
   Eigen::MatrixXd P;
   double q;
+  bool planar = false;  // a 2-D radar's track: no z process noise
   void predict(double T) {
     Eigen::MatrixXd F = Eigen::MatrixXd::Identity(6, 6), Q = Eigen::MatrixXd::Zero(6, 6);
     for (int a = 0; a < 3; ++a) {
       F(2 * a, 2 * a + 1) = T;
+      if (planar && a == 2) continue;
       Q(2 * a, 2 * a) = q * T * T * T / 3;
       Q(2 * a, 2 * a + 1) = Q(2 * a + 1, 2 * a) = q * T * T / 2;
       Q(2 * a + 1, 2 * a + 1) = q * T;
@@ -40,7 +42,13 @@ struct ReferenceEkf {
   static Eigen::VectorXd h(const Eigen::VectorXd& s, const Measurement& m) {
     const Vec3 d = Vec3(s(0), s(2), s(4)) - m.sensor_position, v(s(1), s(3), s(5));
     Eigen::VectorXd out(m.value.size());
-    out.head<3>() = enu_to_spherical(d, m.azimuth);
+    const Vec3 rae = enu_to_spherical(d, m.azimuth);
+    if (m.frame == Frame::Polar) {  // a 2-D radar: [r, az(, rdot)]
+      out.head<2>() = rae.head<2>();
+      if (out.size() == 3) out(2) = range_rate(d, v);
+      return out;
+    }
+    out.head<3>() = rae;
     if (out.size() == 4) out(3) = range_rate(d, v);
     return out;
   }
@@ -465,4 +473,96 @@ TEST_CASE("wrong inputs and parameters are clear errors") {
              Catch::Contains("paper000"));
   CHECK_THAT(error("{ range_rate: always }"), Catch::Contains("range_rate"));
   CHECK(error("{ motion: singer, singer_alpha: 1 1/s, singer_sigma: 2 m/s2, init: paper000 }") == "no error");
+}
+
+// A 2-D radar's polar plots of a target in its horizontal plane: the EKF agrees step by step with the
+// textbook EKF on h = [r, az(, rdot)] (numerical Jacobian), its track stays in the radar's plane
+// (z at the radar's height, zero z variance), and the innovation has the polar size.
+TEST_CASE("2-D radar polar plots agree with a textbook EKF") {
+  for (bool rr : {false, true}) {
+    INFO("range rate " << rr);
+    Run run("{ q: 4 m2/s3 }");
+    Rng rng(33);
+    const Vec3 sensor(100, -200, 15);
+    const double T = 1.0;
+    const double sr = 20.0, saz = 2e-3, srr = 1.0;
+    std::vector<Measurement> ms;
+    for (int k = 0; k < 40; ++k) {
+      const double t = k * T;
+      const Vec3 v(-150, 60, 0), p = Vec3(8e3, 12e3, sensor.z()) + v * t;
+      Measurement m;
+      m.time = t;
+      m.frame = Frame::Polar;
+      m.sensor_position = sensor;
+      m.has_range_rate = rr;
+      const int n = rr ? 3 : 2;
+      m.value.resize(n);
+      m.covariance = MeasCov::Zero(n, n);
+      const Vec3 rae = enu_to_spherical(p - sensor, m.azimuth);
+      m.value(0) = rae(0) + sr * rng.normal();
+      m.value(1) = wrap_angle(rae(1) + saz * rng.normal());
+      m.covariance(0, 0) = sr * sr;
+      m.covariance(1, 1) = saz * saz;
+      if (rr) {
+        m.value(2) = range_rate(p - sensor, v) + srr * rng.normal();
+        m.covariance(2, 2) = srr * srr;
+      }
+      ms.push_back(m);
+      run.feed(m);
+    }
+    const auto& est = run.out.estimates;
+    REQUIRE(est.size() == 40);
+    REQUIRE(est[1].initialised);
+    ReferenceEkf ref;
+    ref.q = 4.0;
+    ref.planar = true;
+    ref.x = Eigen::VectorXd::Zero(6);
+    ref.P = Eigen::MatrixXd::Zero(6, 6);
+    Vec3 z[2];
+    Mat3 R[2];
+    for (int i = 0; i < 2; ++i) {  // classical conversion at elevation 0
+      const auto& v = ms[i].value;
+      z[i] = spherical_to_enu(v(0), v(1), 0.0, ms[i].azimuth) + sensor;
+      Mat3 Rs = Mat3::Zero();
+      Rs.topLeftCorner<2, 2>() = ms[i].covariance.topLeftCorner(2, 2);
+      const Mat3 J = spherical_to_enu_jacobian(v(0), v(1), 0.0, ms[i].azimuth);
+      R[i] = J * Rs * J.transpose();
+    }
+    for (int a = 0; a < 3; ++a) {
+      ref.x(2 * a) = z[1](a);
+      ref.x(2 * a + 1) = (z[1](a) - z[0](a)) / T;
+      for (int b = 0; b < 3; ++b) {
+        ref.P(2 * a, 2 * b) = R[1](a, b);
+        ref.P(2 * a, 2 * b + 1) = ref.P(2 * b + 1, 2 * a) = R[1](a, b) / T;
+        ref.P(2 * a + 1, 2 * b + 1) = (R[0](a, b) + R[1](a, b)) / (T * T);
+      }
+    }
+    CHECK((est[1].state - ref.x).norm() < 1e-9 * ref.x.norm());
+    for (size_t k = 2; k < ms.size(); ++k) {
+      ref.predict(T);
+      ref.update(ms[k]);
+      CHECK(est[k].updated);
+      CHECK((est[k].state - ref.x).norm() < 1e-6 * ref.x.norm());
+      CHECK((est[k].covariance - ref.P).norm() < 1e-5 * ref.P.norm());
+      CHECK(est[k].innovation.size() == (rr ? 3 : 2));
+      CHECK(est[k].enu(2) == sensor.z());  // the track lies in the radar's horizontal plane
+      CHECK(est[k].enu(5) == 0.0);
+      CHECK(est[k].enu_covariance(2, 2) == 0.0);
+    }
+    CHECK(symmetric_pd(est.back().covariance.topLeftCorner(4, 4)));
+  }
+}
+
+// filter.ukf takes no polar plots: refused with the frames it takes; a tilted 2-D radar is refused by filter.ekf.
+TEST_CASE("polar plots: UKF refuses and a tilted 2-D radar is refused") {
+  Measurement m;
+  m.frame = Frame::Polar;
+  m.value = Eigen::Vector2d(5e3, 0.3);
+  m.covariance = MeasCov::Identity(2, 2);
+  FilterRun ukf("filter.ukf", "{ q: 1 m2/s3 }");
+  CHECK_THROWS_WITH(ukf.feed(m), Catch::Contains("takes spherical measurements") && Catch::Contains("polar"));
+  Run ekf("{ q: 1 m2/s3 }");
+  m.sensor_level = false;
+  m.sensor_axes = Eigen::AngleAxisd(0.01, Vec3::UnitX()).toRotationMatrix();
+  CHECK_THROWS_WITH(ekf.feed(m), Catch::Contains("horizontal plane"));
 }

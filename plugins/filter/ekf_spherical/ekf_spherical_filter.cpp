@@ -40,7 +40,7 @@ class SphericalEkf final : public Estimator {
 
  public:
   explicit SphericalEkf(SphericalEkfSettings s)
-      : Estimator(MeasurementSpec{Frame::Spherical, s.range_rate, {"azimuth_dropped"}}),
+      : Estimator(MeasurementSpec{mask(Frame::Spherical), s.range_rate, {"azimuth_dropped"}}),
         s_(std::move(s)) {
     for (int i = 0; i < 3; ++i) q_[i] = s_.q[i];
   }

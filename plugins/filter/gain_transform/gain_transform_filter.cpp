@@ -37,7 +37,7 @@ class GainTransformEstimator final : public Estimator {
 
  public:
   explicit GainTransformEstimator(GainTransformSettings s)
-      : Estimator(MeasurementSpec{Frame::Spherical, RangeRateUse::Ignore, {"azimuth_dropped"}}),
+      : Estimator(MeasurementSpec{mask(Frame::Spherical), RangeRateUse::Ignore, {"azimuth_dropped"}}),
         s_(std::move(s)) {
     for (double& q : q_) q = s_.sigma;
   }

@@ -79,7 +79,7 @@ class ImmEstimator final : public Estimator {
 
  public:
   explicit ImmEstimator(const ImmConfig& c)
-      : Estimator(MeasurementSpec{Frame::Spherical, c.range_rate,
+      : Estimator(MeasurementSpec{mask(Frame::Spherical), c.range_rate,
                                     {"azimuth_dropped", "mode_updates_refused"}, true}),
         count_(static_cast<int>(c.modes.size())) {
     for (int j = 0; j < count_; ++j) {
@@ -354,7 +354,7 @@ class ComponentImmEstimator final : public Estimator {
   friend struct ModeTrack;
   // The IMM's counters: its own, then each mode's own as "<mode>.<counter>".
   static MeasurementSpec spec(const ComponentImmConfig& c) {
-    MeasurementSpec m{Frame::Spherical, c.range_rate, {"mode_updates_refused"}, c.tilted_sensors};
+    MeasurementSpec m{mask(Frame::Spherical), c.range_rate, {"mode_updates_refused"}, c.tilted_sensors};
     for (const EstimatorMode& mode : c.modes)
       for (const std::string& counter : mode.prototype->measurement_spec().counters)
         m.counters.push_back(mode.name + "." + counter);
@@ -583,7 +583,7 @@ ComponentImmConfig make_component_config(const Params& p) {
     auto refuse = [&](const std::string& why) { return ConfigError(label + ": " + why, nc.type_where, p.node()); };
     std::unique_ptr<Estimator> e = nc.create_estimator();
     const MeasurementSpec& spec = e->measurement_spec();
-    if (spec.frame != Frame::Spherical)
+    if (!(spec.frames & mask(Frame::Spherical)))
       throw refuse("it measures in another frame; an IMM's modes take spherical [r, az, el(, rdot)] measurements");
     if (k == 0) {
       c.range_rate = spec.range_rate;

@@ -37,7 +37,8 @@ class KalmanEstimator final : public Estimator {
  public:
   static constexpr int kStateDim = N;  // fill()'s state size: the node's non-finite check is fixed-size
   explicit KalmanEstimator(KalmanSettings s)
-      : Estimator(MeasurementSpec{Frame::Cartesian, RangeRateUse::Ignore, {}}), s_(std::move(s)) {}
+      : Estimator(MeasurementSpec{mask(Frame::Cartesian) | mask(Frame::Planar), RangeRateUse::Ignore, {}}),
+        s_(std::move(s)) {}
   std::unique_ptr<Estimator> clone() const override { return std::make_unique<KalmanEstimator>(*this); }
 
   const TransitionModel* transition_model() const override { return &s_.transition; }
@@ -61,6 +62,7 @@ class KalmanEstimator final : public Estimator {
 
   bool reset() override {
     has_first_ = false;
+    planar_ = false;
     independent_axes_ = true;  // explicit: P diagonal; two-point: set by initialise
     if (s_.two_point) return false;
     x_.setZero();
@@ -88,7 +90,7 @@ class KalmanEstimator final : public Estimator {
     const double scale = s_.noise == KalmanSettings::Noise::Continuous ? s_.q : s_.q * s_.q;
     Model::propagate(T, x_);
     Model::propagate_covariance(T, P_);
-    for (int a = 0; a < 3; ++a)
+    for (int a = 0; a < (planar_ ? 2 : 3); ++a)
       P_.template block<Model::kOrder, Model::kOrder>(a * Model::kOrder, a * Model::kOrder) += scale * unit_Q_;
   }
 
@@ -97,17 +99,19 @@ class KalmanEstimator final : public Estimator {
   // products. When R is diagonal and P has no cross-axis terms (independent_axes_), the three
   // axes are three independent filters on scalar measurements: the same update, per axis.
   bool update(const Measurement& m, int) override {
-    return update_position(m);  // range_rate: ignore makes every measurement 3 positions
+    // range_rate: ignore makes every measurement its positions: 3, or x and y of a planar one.
+    return m.frame == Frame::Planar ? update_position<2>(m) : update_position<3>(m);
   }
 
-  // z^ = H x (the three positions), S = H P H' + R: three rows and columns of P.
-  bool predict_measurement(const SensorFrame&, const MeasCov& R, PredictedMeasurement& p) const override {
-    if (R.rows() != 3 || R.cols() != 3) return false;
-    p.z.resize(3);
-    p.S.resize(3, 3);
-    for (int a = 0; a < 3; ++a) {
+  // z^ = H x (the positions the sensor measures), S = H P H' + R: those rows and columns of P.
+  bool predict_measurement(const SensorFrame& s, const MeasCov& R, PredictedMeasurement& p) const override {
+    const int k = position_values(s.frame);
+    if (R.rows() != k || R.cols() != k) return false;
+    p.z.resize(k);
+    p.S.resize(k, k);
+    for (int a = 0; a < k; ++a) {
       p.z(a) = x_(Model::position_index(a));
-      for (int b = 0; b < 3; ++b) p.S(a, b) = P_(Model::position_index(a), Model::position_index(b)) + R(a, b);
+      for (int b = 0; b < k; ++b) p.S(a, b) = P_(Model::position_index(a), Model::position_index(b)) + R(a, b);
     }
     return set_log_det(p);
   }
@@ -116,18 +120,28 @@ class KalmanEstimator final : public Estimator {
 
   // Two-point differencing (Bar-Shalom, Li & Kirubarajan 2001, §5.5.3): position from the
   // second point, velocity from the difference; covariance from the two R's. A second point
-  // with the same time stamp replaces the first.
+  // with the same time stamp replaces the first. A track started from planar (x, y) points lives
+  // in the plane z = 0: z, vz (az) are 0 with zero variance and get no process noise, so the
+  // sensor's plane is the track's (its z is never updated).
   bool initiate(const Measurement& m, int) override {
-    const Vec3 z = m.value.template head<3>();
-    const Mat3 R = R_.topLeftCorner(3, 3);
+    const bool planar = m.frame == Frame::Planar;
+    const Vec3 z = measured_position(m);
+    Mat3 R = Mat3::Zero();
+    if (planar)
+      R.topLeftCorner<2, 2>() = R_.topLeftCorner(2, 2);
+    else
+      R = R_.topLeftCorner(3, 3);
+    if (has_first_ && planar != first_planar_) has_first_ = false;  // a planar and a 3-D point do not pair
     const double T = m.time - t1_;
     if (!has_first_ || T <= 0.0) {
       z1_ = z;
       R1_ = R;
       t1_ = m.time;
       has_first_ = true;
+      first_planar_ = planar;
       return false;
     }
+    planar_ = planar;
     x_.setZero();
     P_.setZero();
     for (int a = 0; a < 3; ++a) {
@@ -140,7 +154,8 @@ class KalmanEstimator final : public Estimator {
         P_(p, vb) = P_(vb, p) = R(a, b) / T;
         P_(v, vb) = (R(a, b) + R1_(a, b)) / (T * T);
       }
-      if constexpr (Model::kOrder == 3) P_(a * 3 + 2, a * 3 + 2) = s_.sa0 * s_.sa0;
+      if constexpr (Model::kOrder == 3)
+        if (!(planar && a == 2)) P_(a * 3 + 2, a * 3 + 2) = s_.sa0 * s_.sa0;
     }
     P_ = 0.5 * (P_ + P_.transpose()).eval();
     // Diagonal R at both points: no cross-axis terms in P (exactly zero, not merely small).
@@ -152,26 +167,30 @@ class KalmanEstimator final : public Estimator {
 
  private:
 
+  // K positions measured: 3, or x and y (planar).
+  template <int K>
   bool update_position(const Measurement& m) {
-    const Vec3 z = m.value.template head<3>();
-    const Mat3 R = R_.template topLeftCorner<3, 3>();
-    Vec3 nu;
-    for (int a = 0; a < 3; ++a) nu(a) = z(a) - x_(Model::position_index(a));
-    Mat3 S;
+    using VecK = Eigen::Matrix<double, K, 1>;
+    using MatK = Eigen::Matrix<double, K, K>;
+    const VecK z = m.value.template head<K>();
+    const MatK R = R_.template topLeftCorner<K, K>();
+    VecK nu;
+    for (int a = 0; a < K; ++a) nu(a) = z(a) - x_(Model::position_index(a));
+    MatK S;
     double nis = 0.0;
     bool ok;
-    if (independent_axes_ && diagonal(R)) {
-      ok = update_per_axis(nu, R, S, nis);
+    if (independent_axes_ && diagonal<K>(R)) {
+      ok = update_per_axis<K>(nu, R, S, nis);
     } else {
       independent_axes_ = false;  // cross-axis terms from here on
-      Eigen::Matrix<double, N, 3> PHt;
-      for (int a = 0; a < 3; ++a) PHt.col(a) = P_.col(Model::position_index(a));
-      for (int a = 0; a < 3; ++a)
-        for (int b = 0; b < 3; ++b) S(a, b) = PHt(Model::position_index(a), b) + R(a, b);
-      ok = joseph_update_cross<N, 3>(x_, P_, nu, PHt, S, nis);
+      Eigen::Matrix<double, N, K> PHt;
+      for (int a = 0; a < K; ++a) PHt.col(a) = P_.col(Model::position_index(a));
+      for (int a = 0; a < K; ++a)
+        for (int b = 0; b < K; ++b) S(a, b) = PHt(Model::position_index(a), b) + R(a, b);
+      ok = joseph_update_cross<N, K>(x_, P_, nu, PHt, S, nis);
     }
     if (ok) {
-      accept_update<3>(nu, S, nis);
+      accept_update<K>(nu, S, nis);
       return true;
     }
     warn("innovation covariance not positive definite at t=" + std::to_string(m.time) +
@@ -179,19 +198,26 @@ class KalmanEstimator final : public Estimator {
     return false;
   }
 
-  static bool diagonal(const Mat3& A) {
-    return A(0, 1) == 0.0 && A(0, 2) == 0.0 && A(1, 2) == 0.0 && A(1, 0) == 0.0 && A(2, 0) == 0.0 && A(2, 1) == 0.0;
+  template <int K>
+  static bool diagonal(const Eigen::Matrix<double, K, K>& A) {
+    if constexpr (K == 2) {
+      return A(0, 1) == 0.0 && A(1, 0) == 0.0;
+    } else {
+      return A(0, 1) == 0.0 && A(0, 2) == 0.0 && A(1, 2) == 0.0 && A(1, 0) == 0.0 && A(2, 0) == 0.0 && A(2, 1) == 0.0;
+    }
   }
 
   // P block-diagonal per axis and R diagonal: each axis block is updated with its own position,
   // exactly the update above with the zero cross terms left out.
-  bool update_per_axis(const Vec3& nu, const Mat3& R, Mat3& S, double& nis) {
+  template <int K>
+  bool update_per_axis(const Eigen::Matrix<double, K, 1>& nu, const Eigen::Matrix<double, K, K>& R,
+                       Eigen::Matrix<double, K, K>& S, double& nis) {
     constexpr int O = Model::kOrder;
-    for (int a = 0; a < 3; ++a)
+    for (int a = 0; a < K; ++a)
       if (!(P_(a * O, a * O) + R(a, a) > 0.0)) return false;  // x, P untouched, as the full update
     S.setZero();
     nis = 0.0;
-    for (int a = 0; a < 3; ++a) {
+    for (int a = 0; a < K; ++a) {
       Eigen::Matrix<double, O, 1> xa = x_.template segment<O>(a * O);
       typename Model::AxisMatrix Pa = P_.template block<O, O>(a * O, a * O);
       const Eigen::Matrix<double, O, 1> PHt = Pa.col(0);
@@ -215,6 +241,8 @@ class KalmanEstimator final : public Estimator {
   typename Model::AxisMatrix unit_Q_ = Model::AxisMatrix::Zero();
   double last_T_ = -1.0;
   bool has_first_ = false;
+  bool first_planar_ = false;  // the first point was planar (x, y)
+  bool planar_ = false;        // the track lives in z = 0: no z process noise
   // P has no cross-axis terms (R diagonal so far): F, Q and a diagonal-R update keep it so.
   bool independent_axes_ = true;
   Vec3 z1_ = Vec3::Zero();
@@ -274,14 +302,16 @@ void register_components(Registrar& r) {
   ComponentDecl d;
   d.type = "filter.kalman";
   d.kind = ComponentKind::Filter;
-  d.summary = "Linear Kalman filter on Cartesian position measurements; constant-velocity or constant-acceleration motion";
+  d.summary = "Linear Kalman filter on Cartesian (x, y, z) or planar (x, y) position measurements; constant-velocity or constant-acceleration motion";
   d.doc =
       "State [x vx (ax) y vy (ay) z vz (az)] in ENU. Process noise: continuous white noise on the highest "
       "derivative (CV: q [[T^3/3, T^2/2], [T^2/2, T]], CA: Wiener-process acceleration, paper 000 eq 3.19) or, "
       "with sigma_accel, the discrete white-noise model (sigma^2 G G'). Joseph-form update (per axis while R is diagonal). Invalid measurements: "
-      "predict only (coast). Measurement noise R from each measurement's covariance; adapters may replace it.";
+      "predict only (coast). Measurement noise R from each measurement's covariance; adapters may replace it. Planar (x, y) "
+      "measurements: H selects x and y; a track started from two planar points lives in the plane z = 0 (z, vz, az zero "
+      "with zero variance, no z process noise); with init: explicit the z axis is predicted but never updated.";
   d.accepts = mask(ItemKind::Measurement);
-  d.accepts_frames = mask(Frame::Cartesian);
+  d.accepts_frames = mask(Frame::Cartesian) | mask(Frame::Planar);
   d.produces = mask(ItemKind::Estimate);
   d.params = transition_param_specs(transition_choices());
   d.params.insert(d.params.end(), {

@@ -374,3 +374,69 @@ TEST_CASE("two targets into one filter are said and counted") {
   CHECK(s2.find("other_target_measurements") == nullptr);
   CHECK(out2.estimates.back().target == 5u);
 }
+
+// A planar (x, y) sensor: with a diagonal R the axes are independent filters, so the x-y part of
+// the track equals, bit for bit, that of a 3-D filter fed the same x and y (and any z); the planar
+// track stays in z = 0 with zero z variance (no z process noise).
+TEST_CASE("planar x-y measurements track in the plane z 0") {
+  auto planar = test::make("filter.kalman", "{ motion: constant_velocity, q: 2 m2/s3 }");
+  auto full = test::make("filter.kalman", "{ motion: constant_velocity, q: 2 m2/s3 }");
+  test::Collector out_planar, out_full;
+  out_planar.attach_to(*planar);
+  out_full.attach_to(*full);
+  Diagnostics d;
+  planar->start_run({0, 1, &d});
+  full->start_run({0, 1, &d});
+  Rng rng(11);
+  const double sigma = 4.0, T = 0.5;
+  for (int k = 0; k < 40; ++k) {
+    const double t = k * T;
+    const Vec3 z(800 + 30 * t + sigma * rng.normal(), -100 - 12 * t + sigma * rng.normal(), 50 * rng.normal());
+    Measurement m3 = cartesian(t, z, sigma);
+    Measurement m2;
+    m2.time = t;
+    m2.frame = Frame::Planar;
+    m2.value = z.head<2>();
+    m2.covariance = MeasCov::Identity(2, 2) * sigma * sigma;
+    planar->on_measurement(m2, 0);
+    full->on_measurement(m3, 0);
+  }
+  REQUIRE(out_planar.estimates.size() == 40);
+  for (size_t k = 1; k < 40; ++k) {
+    const Estimate &p = out_planar.estimates[k], &f = out_full.estimates[k];
+    REQUIRE(p.initialised);
+    for (int i : {0, 1, 3, 4}) {  // x, y, vx, vy of the ENU block
+      CHECK(p.enu(i) == f.enu(i));
+      for (int j : {0, 1, 3, 4}) CHECK(p.enu_covariance(i, j) == f.enu_covariance(i, j));
+    }
+    CHECK(p.enu(2) == 0.0);
+    CHECK(p.enu(5) == 0.0);
+    CHECK(p.enu_covariance.row(2).norm() == 0.0);
+    CHECK(p.enu_covariance.row(5).norm() == 0.0);
+    if (k > 1) {
+      CHECK(p.innovation.size() == 2);
+      CHECK(p.innovation_covariance.rows() == 2);
+    }
+  }
+  // The planar NIS has 2 degrees of freedom: its mean over the run is near 2, not 3.
+  double nis = 0.0;
+  for (size_t k = 2; k < 40; ++k) nis += out_planar.estimates[k].nis;
+  CHECK(nis / 38.0 < 2.9);
+}
+
+// A detection of another frame, or of the wrong size, is refused with a message naming both.
+TEST_CASE("planar measurement of the wrong size is refused") {
+  auto kf = test::make("filter.kalman", "{ motion: constant_velocity, q: 2 m2/s3 }");
+  Diagnostics d;
+  kf->start_run({0, 1, &d});
+  Measurement m;
+  m.frame = Frame::Planar;
+  m.value = Vec3(1, 2, 3);
+  m.covariance = MeasCov::Identity(3, 3);
+  CHECK_THROWS_WITH(kf->on_measurement(m, 0), Catch::Contains("planar (x-y) measurement") && Catch::Contains("expected 2"));
+  Measurement polar;
+  polar.frame = Frame::Polar;
+  polar.value = Eigen::Vector2d(1000, 0.1);
+  polar.covariance = MeasCov::Identity(2, 2);
+  CHECK_THROWS_WITH(kf->on_measurement(polar, 0), Catch::Contains("takes cartesian/planar (x-y) measurements"));
+}

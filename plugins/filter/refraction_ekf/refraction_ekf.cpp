@@ -48,7 +48,7 @@ class RefractionEkf final : public Estimator {
   enum Counter { kConverged, kNotConverged, kNonFinite, kNormalised };
 
   explicit RefractionEkf(Settings s)
-      : Estimator(MeasurementSpec{Frame::Spherical, RangeRateUse::Ignore,
+      : Estimator(MeasurementSpec{mask(Frame::Spherical), RangeRateUse::Ignore,
                                     {"converged_runs", "not_converged_runs", "non_finite_steps", "gain_normalised"}}),
         s_(std::move(s)) {
     for (int i = 0; i < kN; ++i) scale_(i) = i < 9 ? s_.scale : 1.0;

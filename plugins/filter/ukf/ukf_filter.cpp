@@ -45,6 +45,9 @@ class UnscentedKalmanFilter final
       : Base(std::move(s)), weights_(ukf::ScaledWeights::make(N, u.alpha, u.beta, u.kappa)) {}
 
   static std::vector<std::string> counter_names() { return {}; }
+  // Spherical only: a 2-D radar's track has a zero-variance z (cartesian_radar_state.hpp), for which
+  // the sigma points' Cholesky factor does not exist.
+  static constexpr FrameMask kFrames = mask(Frame::Spherical);
 
  private:
   void on_start_run() {

@@ -24,7 +24,7 @@ struct GatedPair {
 // For each track with a predicted measurement (a positive definite S), the detections with
 // NIS = nu' S^-1 nu <= gamma = chi2inv(P_G, dim) (gating.hpp; the azimuth residual wrapped).
 //
-// Pre-gate: on a Cartesian scan the detections are binned by (x, y) in a PointGrid whose cell
+// Pre-gate: on a Cartesian or planar scan the detections are binned by (x, y) in a PointGrid whose cell
 // side is the median over the tracks of their gate's width; a track tests only the detections in
 // the cells its gate's bounding box overlaps. The box is exact, not a heuristic: on the ellipsoid
 // nu' S^-1 nu <= gamma, |nu_k| <= sqrt(gamma S_kk) (the maximum of a linear function over an
@@ -44,15 +44,17 @@ class GatedPairs {
     gates_.resize(n);
     memory::assign_grown(ok_, n, char{0});
     widths_.clear();
+    // Cartesian and planar detections start with (x, y): both bin by it.
+    const bool xy = scan.sensor.frame == Frame::Cartesian || scan.sensor.frame == Frame::Planar;
     for (std::size_t i = 0; i < n; ++i) {
       if (!tracks[i].predicted || !gates_[i].set(*tracks[i].predicted, scan.sensor.frame)) continue;
       ok_[i] = 1;
-      if (scan.sensor.frame == Frame::Cartesian) {
+      if (xy) {
         const MeasCov& S = tracks[i].predicted->S;
         widths_.push_back(2.0 * std::sqrt(threshold(gates_[i].dim()) * std::max(S(0, 0), S(1, 1))));
       }
     }
-    const bool grid = scan.sensor.frame == Frame::Cartesian && !widths_.empty();
+    const bool grid = xy && !widths_.empty();
     if (grid) {
       points_.resize(m);
       for (std::size_t j = 0; j < m; ++j) points_[j] = scan.detections[j].value.head<2>();

@@ -20,7 +20,7 @@ class PredictedGate {
   // false when S is not positive definite (the track takes no detection).
   bool set(const PredictedMeasurement& p, Frame frame) {
     z_ = &p.z;
-    spherical_ = frame == Frame::Spherical;
+    azimuth_ = has_azimuth(frame);
     dim_ = static_cast<int>(p.z.size());
     llt_.compute(p.S);
     log_det_ = p.log_det_S;
@@ -30,10 +30,10 @@ class PredictedGate {
   int dim() const { return dim_; }
 
   // nu' S^-1 nu of detection value `value` (its leading dim() elements); the azimuth residual of a
-  // spherical measurement is wrapped to (-pi, pi].
+  // spherical or polar measurement is wrapped to (-pi, pi].
   double nis(const MeasVec& value) const {
     MeasVec nu = value.head(dim_) - *z_;
-    if (spherical_) nu(1) = wrap_angle(nu(1));
+    if (azimuth_) nu(1) = wrap_angle(nu(1));
     const MeasVec w = llt_.matrixL().solve(nu);
     return w.squaredNorm();
   }
@@ -45,7 +45,7 @@ class PredictedGate {
 
  private:
   const MeasVec* z_ = nullptr;
-  bool spherical_ = false;
+  bool azimuth_ = false;  // value(1) is an azimuth (Spherical, Polar): its residual wraps
   int dim_ = 0;
   Eigen::LLT<MeasCov> llt_;
   double log_det_ = 0.0;

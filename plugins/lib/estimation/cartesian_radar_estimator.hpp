@@ -22,6 +22,8 @@ namespace trackflow::cartesian_filter {
 //   void on_start_run();  void on_end_run_report();    its own per-run state and reports
 //   template <int M> bool correct(const Measurement&); M = 3 or 4: correct x_ and P_ with the
 //       measurement's first M values and R_.topLeftCorner(M, M); call accept_update() on success.
+//   static constexpr FrameMask kFrames;                 Spherical, and Polar if it has
+//   template <int M> bool correct_polar(const Measurement&); M = 2 or 3 ([r, az(, rdot)]).
 template <int Order, class Derived>
 class CartesianRadarEstimator : public Estimator, protected CartesianRadarState<Order> {
   using State = CartesianRadarState<Order>;
@@ -64,7 +66,18 @@ class CartesianRadarEstimator : public Estimator, protected CartesianRadarState<
     return this->reset_state();
   }
   bool update(const Measurement& m, int dim) override {
+    if constexpr ((Derived::kFrames & mask(Frame::Polar)) != 0) {
+      if (m.frame == Frame::Polar)
+        return dim == 3 ? derived().template correct_polar<3>(m) : derived().template correct_polar<2>(m);
+    }
     return dim == 4 ? derived().template correct<4>(m) : derived().template correct<3>(m);
+  }
+  // A 2-D radar's track lies in its horizontal plane (cartesian_radar_state.hpp): a tilted one has
+  // no such plane in the frame.
+  void check(const Measurement& m) override {
+    if (m.frame == Frame::Polar && !m.sensor_level)
+      throw DataError(this->who() + ": " + tilted_sensor_message(m) +
+                      " (a 2-D radar's targets are placed in its horizontal plane, which must be the frame's)");
   }
   bool predict_measurement(const SensorFrame& s, const MeasCov& R, PredictedMeasurement& p) const override {
     return predicted_by_update<Derived>(s, R, p);
@@ -83,7 +96,7 @@ class CartesianRadarEstimator : public Estimator, protected CartesianRadarState<
 
  protected:
   explicit CartesianRadarEstimator(Settings s)
-      : Estimator(MeasurementSpec{Frame::Spherical, s.range_rate, Derived::counter_names(), true}), State(s) {}
+      : Estimator(MeasurementSpec{Derived::kFrames, s.range_rate, Derived::counter_names(), true}), State(s) {}
 
   using State::settings;
   using State::x_;

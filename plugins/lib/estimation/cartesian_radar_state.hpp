@@ -45,6 +45,7 @@ class CartesianRadarState {
   // Start of a run: forget the track; true when it starts initialised (init: explicit).
   bool reset_state() {
     points_ = 0;
+    planar_ = false;
     last_T_ = -1.0;
     if (s_.init != Settings::Init::Explicit) return false;
     x_.setZero();
@@ -137,13 +138,29 @@ class CartesianRadarState {
 
   // axisQ_ is for unit intensity; q_ may be retuned by adapters between steps.
   double noise_scale(int axis) const {
+    if (axis == 2 && planar_) return 0.0;  // a 2-D radar's track stays in the radar's horizontal plane
     return s_.noise == Settings::Noise::Continuous ? q_[axis] : q_[axis] * q_[axis];
   }
 
   // Collects converted positions until the state can be formed: two points (two_point; paper000
   // with CV), three (paper000 with CA/Singer).
-  // R: the measurement's spherical covariance (at least 3x3).
+  // R: the measurement's spherical covariance (at least 3x3), or polar (at least 2x2). A 2-D
+  // radar's (Polar) points are taken in its horizontal plane (elevation 0, geometry.hpp): the track
+  // lives there, its z at the radar's height with zero variance and no z process noise, so the
+  // slant range it predicts is the ground range. A polar and a spherical point do not pair.
   bool add_point(const Measurement& m, const MeasCov& R) {
+    const bool polar = m.frame == Frame::Polar;
+    if (points_ > 0 && polar != planar_) points_ = 0;
+    planar_ = polar;
+    if (polar) {
+      if (points_ > 0 && m.time == tc_[points_ - 1]) --points_;
+      zc_[points_] = measured_position(m);
+      const Mat3 Rc = measured_position_covariance(m, R);
+      Rc_[points_] = 0.5 * (Rc + Rc.transpose());
+      tc_[points_] = m.time;
+      ++points_;
+      return form_state();
+    }
     if (points_ > 0 && m.time == tc_[points_ - 1]) --points_;  // same time stamp: keep the newer one
     // Classical conversion with the exact Jacobian covariance (as convert.classical).
     const double r = m.value(0), az = m.value(1), el = m.value(2);
@@ -156,6 +173,9 @@ class CartesianRadarState {
     Rc_[points_] = 0.5 * (Rc + Rc.transpose());
     tc_[points_] = m.time;
     ++points_;
+    return form_state();
+  }
+  bool form_state() {
     const bool three = s_.init == Settings::Init::Paper000 && Order == 3;
     if (points_ < (three ? 3 : 2)) return false;
     x_.setZero();
@@ -182,7 +202,8 @@ class CartesianRadarState {
         P_(p, vb) = P_(vb, p) = R2(a, b) / T;
         P_(v, vb) = (R1(a, b) + R2(a, b)) / (T * T);
       }
-      if constexpr (Order == 3) P_(a * 3 + 2, a * 3 + 2) = s_.sa0 * s_.sa0;
+      if constexpr (Order == 3)
+        if (!(planar_ && a == 2)) P_(a * 3 + 2, a * 3 + 2) = s_.sa0 * s_.sa0;
     }
   }
 
@@ -220,6 +241,7 @@ class CartesianRadarState {
   AxisMatrix axisQ_ = AxisMatrix::Zero();
   double last_T_ = -1.0;
   int points_ = 0;
+  bool planar_ = false;  // the track lies in a 2-D radar's horizontal plane
   Vec3 zc_[3];
   Mat3 Rc_[3];
   double tc_[3] = {};

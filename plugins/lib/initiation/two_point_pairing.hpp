@@ -42,7 +42,8 @@ inline const char* pairing_doc() {
 }
 
 // A detection's position in the frame and the standard deviation of its position error (the root
-// of the trace of its position covariance: Cartesian R, or J R J' of a spherical detection).
+// of the trace of its position covariance: Cartesian R, or J R J' of a spherical or polar one;
+// geometry.hpp places a 2-D detection in its plane).
 struct Located {
   Vec3 position = Vec3::Zero();
   double sigma = 0.0;
@@ -50,15 +51,8 @@ struct Located {
 
 inline Located locate(const Measurement& m) {
   Located l;
-  const Mat3 R = m.covariance.topLeftCorner<3, 3>();
-  if (m.frame == Frame::Cartesian) {
-    l.position = m.value.head<3>();
-    l.sigma = std::sqrt(R.trace());
-  } else {
-    l.position = measured_position(m);
-    const Mat3 J = spherical_to_enu_jacobian(m.value(0), m.value(1), m.value(2), m.azimuth);
-    l.sigma = std::sqrt((J * R * J.transpose()).trace());
-  }
+  l.position = measured_position(m);
+  l.sigma = std::sqrt(measured_position_covariance(m, m.covariance).trace());
   return l;
 }
 

@@ -1,4 +1,4 @@
-// Purpose: sim.scan_radar — a radar in scan mode: per instant one Scan of every target in its coverage, detected with P_D (constant, Swerling 0 or I from SNR), spherical noise, Poisson clutter uniform over its range–azimuth–elevation cells, optional merged unresolved plots.
+// Purpose: sim.scan_radar — a radar in scan mode: per instant one Scan of every target in its coverage, detected with P_D (constant, Swerling 0 or I from SNR), spherical noise, Poisson clutter uniform over its range–azimuth(–elevation) cells, optional merged unresolved plots; 3-D or 2-D (range, azimuth).
 #include "detection_models.hpp"
 #include "simulation/detection_order.hpp"
 #include "simulation/poisson.hpp"
@@ -25,6 +25,8 @@ using scan_radar::snr_at_range;
 using simulation::poisson;
 
 enum class DetectionModel { Constant, Swerling0, Swerling1 };
+// What a plot measures: range, azimuth and elevation, or a 2-D surveillance radar's range and azimuth.
+enum class Measures { RangeAzimuthElevation, RangeAzimuth };
 constexpr double kTwoPi = 2.0 * std::numbers::pi;
 
 struct Settings {
@@ -36,6 +38,10 @@ struct Settings {
   double clutter_mean = 0.0;
   bool merge = false;
   Vec3 resolution = Vec3::Zero();  // range resolution, azimuth and elevation beamwidths
+  // Measured dimensions: 3 (r, az, el) or 2 (r, az; Frame::Polar). A 2-D radar's fan beam covers
+  // [elevation_min, elevation_max] but does not resolve elevation: cells, clutter and merging are in
+  // (r, az) only.
+  int dims = 3;
 };
 
 struct ScanRadarRunResult final : RunResult {
@@ -55,13 +61,28 @@ struct Echo {
 
 double cell_count(const Settings& s) {
   double n = 1.0;
-  for (int i = 0; i < 3; ++i) n *= (s.hi[i] - s.lo[i]) / s.resolution[i];
+  for (int i = 0; i < s.dims; ++i) n *= (s.hi[i] - s.lo[i]) / s.resolution[i];
   return n;
+}
+
+// The coverage's volume in measurement space: m rad² (3-D) or m rad (2-D).
+double coverage_volume(const Settings& s) {
+  double v = 1.0;
+  for (int i = 0; i < s.dims; ++i) v *= s.hi[i] - s.lo[i];
+  return v;
 }
 
 Settings read_settings(const Params& p) {
   Settings s;
   s.sensor.frame = Frame::Spherical;
+  if (p.choice<Measures>("measures") == Measures::RangeAzimuth) {
+    s.dims = 2;
+    s.sensor.frame = Frame::Polar;
+    for (const char* name : {"sigma_elevation", "beamwidth_elevation", "clutter_density"})
+      if (p.given(name))
+        throw p.error(name, std::string("has no use with 'measures: range_azimuth' (a 2-D radar measures no elevation)") +
+                                (std::string(name) == "clutter_density" ? "; give clutter_rate (per scan)" : ""));
+  }
   s.sensor.sensor = static_cast<std::uint32_t>(p.integer("sensor_id"));
   s.sensor.azimuth = p.choice<AzimuthConvention>("azimuth_convention");
   s.sensor.sensor_position = p.vec3("position");
@@ -90,7 +111,7 @@ Settings read_settings(const Params& p) {
   s.resolution = {p.real("range_resolution"), p.real("beamwidth_azimuth"), p.real("beamwidth_elevation")};
   if (p.given("clutter_rate") && p.given("clutter_density"))
     throw p.error("clutter_density", "give either 'clutter_rate' (per scan) or 'clutter_density' (per m rad2), not both");
-  const double volume = (s.hi - s.lo).prod();
+  const double volume = coverage_volume(s);
   if (p.given("clutter_density"))
     s.clutter_mean = p.real("clutter_density") * volume;
   else if (p.given("clutter_rate"))
@@ -108,12 +129,12 @@ class ScanRadar final : public Component, public FieldListCodec<ScanRadarRunResu
   ScanRadar(const Params& p) : node_(p.node()), s_(read_settings(p)) {
     scan_.sensor = s_.sensor;
     scan_.region.known = true;
-    scan_.region.dim = 3;
-    for (int i = 0; i < 3; ++i) {
+    scan_.region.dim = s_.dims;
+    for (int i = 0; i < s_.dims; ++i) {
       scan_.region.lo[i] = s_.lo[i];
       scan_.region.hi[i] = s_.hi[i];
     }
-    scan_.clutter_density = s_.clutter_mean / (s_.hi - s_.lo).prod();
+    scan_.clutter_density = s_.clutter_mean / coverage_volume(s_);
     scan_.detection_probability = s_.model == DetectionModel::Constant ? s_.pd : std::numeric_limits<double>::quiet_NaN();
     const double clutter = s_.clutter_mean + 6.0 * std::sqrt(s_.clutter_mean) + 8.0;
     detections_.reserve(64 + static_cast<std::size_t>(clutter));
@@ -209,10 +230,11 @@ class ScanRadar final : public Component, public FieldListCodec<ScanRadarRunResu
       echoes_.push_back({pending_[i].target, rae, false});
     }
     detections_.clear();
+    const bool elevation = s_.dims == 3;
     Detection d;
-    d.value.resize(3);
-    d.covariance.setZero(3, 3);
-    for (int i = 0; i < 3; ++i) d.covariance(i, i) = s_.sigma[i] * s_.sigma[i];
+    d.value.resize(s_.dims);
+    d.covariance.setZero(s_.dims, s_.dims);
+    for (int i = 0; i < s_.dims; ++i) d.covariance(i, i) = s_.sigma[i] * s_.sigma[i];
     for (std::size_t i = 0; i < echoes_.size(); ++i) {
       Echo& e = echoes_[i];
       if (e.merged) continue;
@@ -226,7 +248,7 @@ class ScanRadar final : public Component, public FieldListCodec<ScanRadarRunResu
           if (o.merged) continue;
           const double daz = wrap_angle(o.rae[1] - e.rae[1]);
           if (std::fabs(o.rae[0] - e.rae[0]) <= s_.resolution[0] && std::fabs(daz) <= s_.resolution[1] &&
-              std::fabs(o.rae[2] - e.rae[2]) <= s_.resolution[2]) {
+              (!elevation || std::fabs(o.rae[2] - e.rae[2]) <= s_.resolution[2])) {
             o.merged = true;
             centre += Vec3(o.rae[0], e.rae[1] + daz, o.rae[2]);
             ++group;
@@ -241,7 +263,7 @@ class ScanRadar final : public Component, public FieldListCodec<ScanRadarRunResu
       }
       d.value[0] = centre[0] + s_.sigma[0] * rng_.normal();
       d.value[1] = wrap_angle(centre[1] + s_.sigma[1] * rng_.normal());
-      d.value[2] = centre[2] + s_.sigma[2] * rng_.normal();
+      if (elevation) d.value[2] = centre[2] + s_.sigma[2] * rng_.normal();
       d.origin = e.target;
       detections_.push_back(d);
       run_.detections += static_cast<std::uint64_t>(group);
@@ -250,7 +272,7 @@ class ScanRadar final : public Component, public FieldListCodec<ScanRadarRunResu
     for (std::uint64_t n = poisson(rng_, s_.clutter_mean); n > 0; --n) {
       d.value[0] = s_.lo[0] + (s_.hi[0] - s_.lo[0]) * rng_.uniform();
       d.value[1] = wrap_angle(s_.lo[1] + (s_.hi[1] - s_.lo[1]) * rng_.uniform());
-      d.value[2] = s_.lo[2] + (s_.hi[2] - s_.lo[2]) * rng_.uniform();
+      if (elevation) d.value[2] = s_.lo[2] + (s_.hi[2] - s_.lo[2]) * rng_.uniform();
       detections_.push_back(d);
       ++run_.clutter;
     }
@@ -294,8 +316,12 @@ const char* const kDoc =
     "clutter_density (expected clutter per m rad²) and, with constant P_D, its detection_probability (NaN with a "
     "Swerling model: P_D varies with range; give the associator its own). Random draws per look, from the run's "
     "seed: per plot in target-id order one uniform (detection) and, if detected, three normals; then the clutter "
-    "count and three uniforms per clutter detection; identical for any --threads. Elevation is not folded; a "
-    "2-D (range, azimuth) radar is not offered: the estimators take spherical measurements with elevation.";
+    "count and three uniforms per clutter detection; identical for any --threads. Elevation is not folded. "
+    "measures: range_azimuth makes it a 2-D surveillance radar: plots [r, az] (Frame::Polar; r the slant range) with "
+    "covariance diag(sigma_range², sigma_azimuth²), the fan beam covering [elevation_min, elevation_max]; resolution "
+    "cells, merging and clutter in (r, az) only (clutter_rate, or P_FA × (Δr/range_resolution)(Δaz/beamwidth_azimuth)), "
+    "region dim 2, clutter_density per m rad; two normals per plot and two uniforms per clutter detection. filter.ekf "
+    "tracks such plots in the radar's horizontal plane.";
 
 void register_components(Registrar& r) {
   ComponentDecl d;
@@ -333,6 +359,11 @@ void register_components(Registrar& r) {
       ParamSpec::real("clutter_rate", dim::none, "expected clutter detections per scan (or clutter_density)").at_least(0),
       ParamSpec::real("clutter_density", per_m_rad2, "instead of clutter_rate: expected clutter per m rad2 of the coverage").at_least(0),
       ParamSpec::boolean("merge_unresolved", "targets within one resolution cell give one plot").def("false"),
+      ParamSpec::choice<Measures>("measures",
+                                  {{Measures::RangeAzimuthElevation, "range_azimuth_elevation"},
+                                   {Measures::RangeAzimuth, "range_azimuth"}},
+                                  "what a plot holds: [r, az, el], or a 2-D surveillance radar's [r, az] (polar)")
+          .def("range_azimuth_elevation"),
       ParamSpec::real("range_resolution", dim::length, "resolution cell: range extent (merging, Swerling clutter)").def("15 m").positive(),
       ParamSpec::real("beamwidth_azimuth", dim::angle, "resolution cell: azimuth beamwidth").def("1 deg").positive(),
       ParamSpec::real("beamwidth_elevation", dim::angle, "resolution cell: elevation beamwidth").def("1 deg").positive(),

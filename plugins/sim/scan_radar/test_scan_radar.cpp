@@ -21,6 +21,7 @@ namespace {
 constexpr double kDeg = std::numbers::pi / 180.0;
 
 struct Look {
+  Frame frame = Frame::Spherical;
   double time = 0.0;
   std::vector<Detection> detections;
   SurveillanceRegion region;
@@ -30,7 +31,8 @@ struct Look {
 class Recorder final : public Component {
  public:
   void on_scan(const Scan& s, int) override {
-    looks.push_back({s.time, {s.detections.begin(), s.detections.end()}, s.region, s.clutter_density, s.detection_probability});
+    looks.push_back({s.sensor.frame, s.time, {s.detections.begin(), s.detections.end()}, s.region, s.clutter_density,
+                     s.detection_probability});
   }
   std::vector<Look> looks;
 };
@@ -226,4 +228,45 @@ TEST_CASE("refuses contradictory or impossible parameters", "[scan_radar]") {
   CHECK_THAT(refusal("range_max: 10 km\nclutter_rate: 3\nclutter_density: 1e-6\n"), Catch::Contains("not both"));
   CHECK_THAT(refusal("range_max: 1000 km\nclutter_density: 10\n"), Catch::Contains("1e7"));
   CHECK_THAT(refusal("sigma_range: 1 m\n"), Catch::Contains("range_max"));
+}
+
+// measures: range_azimuth — a 2-D surveillance radar: polar [r, az] plots with a 2x2 covariance,
+// clutter over range-azimuth (density per m rad), the fan beam's elevation coverage still applies,
+// and merging ignores elevation.
+TEST_CASE("2-D radar gives polar range-azimuth plots", "[scan_radar]") {
+  Radar radar("measures: range_azimuth\nrange_min: 10 km\nrange_max: 20 km\nazimuth_min: 0 deg\n"
+              "azimuth_max: 90 deg\nelevation_max: 10 deg\nsigma_range: 5 m\nsigma_azimuth: 2 mrad\n"
+              "detection_probability: 1\nclutter_rate: 3\nmerge_unresolved: true\nbeamwidth_azimuth: 1 deg\n"
+              "range_resolution: 50 m\n");
+  const int looks = 3000;
+  for (int k = 0; k < looks; ++k) {
+    radar.truth(k, 0, at(15e3, 45 * kDeg, 2 * kDeg));
+    radar.truth(k, 1, at(15e3 + 20, 45.2 * kDeg, 8 * kDeg));  // one (r, az) cell, elevations apart
+    radar.truth(k, 2, at(12e3, 30 * kDeg, 20 * kDeg));        // above the fan beam
+    radar.node->on_time_complete(k);
+  }
+  REQUIRE(radar.rec.looks.size() == static_cast<size_t>(looks));
+  int clutter = 0, plots = 0;
+  for (const auto& l : radar.rec.looks) {
+    CHECK(l.frame == Frame::Polar);
+    CHECK(l.region.dim == 2);
+    for (const auto& d : l.detections) {
+      REQUIRE(d.value.size() == 2);
+      REQUIRE(d.covariance.rows() == 2);
+      CHECK(d.covariance(1, 1) == Approx(4e-6));
+      if (d.origin == kOriginClutter) {
+        ++clutter;
+        CHECK(d.value[0] >= 10e3);
+        CHECK(d.value[0] <= 20e3);
+      } else {
+        CHECK(d.origin == 0);  // target 1 merged into 0; target 2 out of the beam
+        ++plots;
+      }
+    }
+  }
+  CHECK(plots == looks);
+  CHECK(static_cast<double>(clutter) / looks == Approx(3.0).margin(4.0 * std::sqrt(3.0 / looks)));
+  CHECK(radar.rec.looks[0].clutter_density == Approx(3.0 / (10e3 * 90 * kDeg)));
+  CHECK_THAT(refusal("measures: range_azimuth\nrange_max: 10 km\nsigma_elevation: 1 mrad\n"),
+             Catch::Contains("sigma_elevation") && Catch::Contains("no elevation"));
 }

@@ -28,6 +28,9 @@ constexpr double kTimeTolerance = 1e-9;  // s
 // Planar without a z range: clutter z is spread over ± this many sigma_z around z = 0.
 constexpr double kPlanarZSigmas = 3.0;
 
+// What each detection measures: the ENU position, or its x and y (a planar position sensor).
+enum class Measured { Xyz, Xy };
+
 struct Box {
   Vec3 lo = Vec3::Zero(), hi = Vec3::Zero();
   double volume() const { return (hi - lo).prod(); }
@@ -63,6 +66,7 @@ struct Settings {
   Vec3 birth_v_mean = Vec3::Zero(), birth_v_sigma = Vec3::Zero();
   double q = 0.0;
   bool planar = false;
+  int measured = 3;  // position values per detection: 3 (x, y, z) or 2 (planar x, y)
   SensorFrame sensor;
   double pd = 1.0;
   Vec3 sigma = Vec3::Ones();
@@ -164,6 +168,14 @@ Settings read_settings(const Params& p) {
 
   s.sensor.sensor = static_cast<std::uint32_t>(p.integer("sensor"));
   s.sensor.frame = Frame::Cartesian;
+  if (p.choice<Measured>("detections") == Measured::Xy) {
+    if (!s.planar) throw p.error("detections", "xy (planar x-y detections) needs 'planar: true'");
+    if (p.given("measurement_sigma_z")) throw p.error("measurement_sigma_z", "has no use with 'detections: xy' (z is not measured)");
+    if (p.given("clutter_density"))
+      throw p.error("clutter_density", "is per m3; with 'detections: xy' give clutter_rate (per scan over the x-y region)");
+    s.measured = 2;
+    s.sensor.frame = Frame::Planar;
+  }
   s.sensor.sensor_position = p.vec3("sensor_position");
   return s;
 }
@@ -185,12 +197,13 @@ class ScenarioSource final : public Generator, public FieldListCodec<ScenarioRun
     detections_.reserve(population + static_cast<std::size_t>(clutter));
     scan_.sensor = s_.sensor;
     scan_.region.known = true;
-    scan_.region.dim = 3;
+    scan_.region.dim = s_.measured;
     for (int i = 0; i < 3; ++i) {
       scan_.region.lo[i] = s_.region.lo[i];
       scan_.region.hi[i] = s_.region.hi[i];
     }
-    scan_.clutter_density = s_.clutter_mean / s_.region.volume();
+    if (s_.measured == 2) scan_.region.lo[2] = scan_.region.hi[2] = 0.0;
+    scan_.clutter_density = s_.clutter_mean / scan_.region.volume();
     scan_.detection_probability = s_.pd;
   }
 
@@ -325,23 +338,24 @@ class ScenarioSource final : public Generator, public FieldListCodec<ScenarioRun
 
   void sense(double t) {
     detections_.clear();
+    const int k = s_.measured;
     Detection d;
-    d.value.resize(3);
-    d.covariance.setZero(3, 3);
-    for (int i = 0; i < 3; ++i) d.covariance(i, i) = s_.sigma[i] * s_.sigma[i];
+    d.value.resize(k);
+    d.covariance.setZero(k, k);
+    for (int i = 0; i < k; ++i) d.covariance(i, i) = s_.sigma[i] * s_.sigma[i];
     for (const Target& x : living_) {
       if (!(rng_.uniform() < s_.pd)) {
         ++run_.missed;
         continue;
       }
-      for (int i = 0; i < 3; ++i) d.value[i] = x.position[i] + s_.sigma[i] * rng_.normal();
+      for (int i = 0; i < k; ++i) d.value[i] = x.position[i] + s_.sigma[i] * rng_.normal();
       d.origin = x.id;
       detections_.push_back(d);
       ++run_.detections;
     }
     d.origin = kOriginClutter;
     for (std::uint64_t n = poisson(rng_, s_.clutter_mean); n > 0; --n) {
-      for (int i = 0; i < 3; ++i) d.value[i] = s_.region.lo[i] + (s_.region.hi[i] - s_.region.lo[i]) * rng_.uniform();
+      for (int i = 0; i < k; ++i) d.value[i] = s_.region.lo[i] + (s_.region.hi[i] - s_.region.lo[i]) * rng_.uniform();
       detections_.push_back(d);
       ++run_.clutter;
     }
@@ -403,7 +417,9 @@ void register_components(Registrar& r) {
       "at sensor_position, its region the surveillance box (known, dim 3), its clutter_density the expected clutter "
       "over the region's volume and its detection_probability P_D. planar: true keeps every target in z = 0 (z "
       "velocity 0, no z noise); detections stay 3-D, z measured with σ_z, and region_lo/hi may then have 2 values, "
-      "the z range being ±3 σ_z. All draws come from this node's run seed, in a fixed order (survival tests, motion "
+      "the z range being ±3 σ_z. detections: xy (with planar: true) makes them planar instead: value [x, y], "
+      "covariance diag(σ², σ²), a Planar scan whose region is the x-y rectangle (dim 2; clutter_rate spread over it). "
+      "All draws come from this node's run seed, in a fixed order (survival tests, motion "
       "noise per target and axis, random births, then per target a detection test and its noise, clutter count and "
       "positions), so results are identical for any --threads.";
   d.params = {
@@ -425,6 +441,10 @@ void register_components(Registrar& r) {
           .def("0 m2/s3")
           .at_least(0),
       ParamSpec::boolean("planar", "targets stay in z = 0 (z velocity 0, no z noise)").def("false"),
+      ParamSpec::choice<Measured>("detections", {{Measured::Xyz, "xyz"}, {Measured::Xy, "xy"}},
+                                  "what a detection measures: x, y, z (Cartesian scans) or, with planar: true, x and y "
+                                  "(Planar scans of a planar position sensor)")
+          .def("xyz"),
       ParamSpec::integer("sensor", "sensor id written into each Scan").def("0").at_least(0).at_most(4294967295.0),
       ParamSpec::real_list("sensor_position", dim::length, "sensor position in the ENU frame", 3).def("[0, 0, 0]"),
       ParamSpec::real("detection_probability", dim::none, "P_D of each living target per scan").def("1").at_least(0).at_most(1),
@@ -440,7 +460,7 @@ void register_components(Registrar& r) {
   d.min_inputs = 0;
   d.max_inputs = 0;
   d.produces = ItemKind::Truth | ItemKind::Scan;
-  d.produces_frames = mask(Frame::Cartesian);
+  d.produces_frames = mask(Frame::Cartesian) | mask(Frame::Planar);
   d.time_ordered = true;
   d.create = [](const Params& p) { return std::make_unique<ScenarioSource>(read_settings(p)); };
   r.add(std::move(d));

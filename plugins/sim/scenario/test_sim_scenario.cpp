@@ -24,6 +24,7 @@ struct Event {
   std::vector<Detection> detections;  // scan
   double clutter_density = 0.0, pd = 0.0;
   SurveillanceRegion region;
+  Frame frame = Frame::Cartesian;
 };
 
 class Recorder final : public Component {
@@ -43,6 +44,7 @@ class Recorder final : public Component {
     e.clutter_density = s.clutter_density;
     e.pd = s.detection_probability;
     e.region = s.region;
+    e.frame = s.sensor.frame;
     events.push_back(e);
   }
   std::vector<Event> events;
@@ -299,4 +301,50 @@ TEST_CASE("refusals name their parameter") {
   CHECK_THAT(refusal(base + "planar: true\ntargets: [{initial_position: [0, 0, 5]}]\n"), Catch::Contains("initial_position"));
   CHECK_THAT(refusal(base + "clutter_density: 1 m\n"), Catch::Contains("clutter_density"));
   CHECK(refusal(base).empty());
+}
+
+// detections: xy makes a planar position sensor: 2-value detections with a 2x2 covariance, clutter
+// over the x-y rectangle (region dim 2, density per m2), and refusals for what has no meaning there.
+TEST_CASE("planar x-y detections of a planar sensor") {
+  const auto ev = simulate(R"(
+    duration: 200 s
+    planar: true
+    detections: xy
+    region_lo: [0, 0]
+    region_hi: [1000 m, 500 m]
+    initial_targets: 3
+    birth_velocity_sigma: [1, 1, 0]
+    measurement_sigma: 2 m
+    clutter_rate: 4
+  )");
+  int scans = 0, clutter = 0, hits = 0;
+  for (const Event& e : ev) {
+    if (!e.scan) continue;
+    ++scans;
+    CHECK(e.frame == Frame::Planar);
+    CHECK(e.region.dim == 2);
+    CHECK(e.region.volume() == Approx(1000.0 * 500.0));
+    CHECK(e.clutter_density == Approx(4.0 / (1000.0 * 500.0)));
+    for (const Detection& d : e.detections) {
+      REQUIRE(d.value.size() == 2);
+      REQUIRE(d.covariance.rows() == 2);
+      CHECK(d.covariance(0, 0) == Approx(4.0));
+      if (d.origin == kOriginClutter) {
+        ++clutter;
+        CHECK(d.value[0] >= 0.0);
+        CHECK(d.value[0] <= 1000.0);
+        CHECK(d.value[1] <= 500.0);
+      } else {
+        ++hits;
+      }
+    }
+  }
+  CHECK(scans == 201);
+  CHECK(hits == 3 * 201);
+  CHECK(static_cast<double>(clutter) / scans == Approx(4.0).margin(4.0 * std::sqrt(4.0 / scans)));
+  CHECK_THAT(refusal("duration: 10 s\ndetections: xy\nregion_lo: [0, 0, 0]\nregion_hi: [1, 1, 1]\n"),
+             Catch::Contains("detections") && Catch::Contains("planar: true"));
+  CHECK_THAT(refusal("duration: 10 s\nplanar: true\ndetections: xy\nregion_lo: [0, 0]\nregion_hi: [1, 1]\n"
+                     "clutter_density: 1e-6 1/m3\n"),
+             Catch::Contains("clutter_rate"));
 }

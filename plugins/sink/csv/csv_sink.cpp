@@ -263,7 +263,7 @@ class CsvSink final : public Component, public RunResultCodec {
   void on_scan(const Scan& s, int port) override {
     if (!include_detections_) return;
     for (const Detection& d : s.detections) {
-      if (d.value.size() < 3) continue;
+      if (d.value.size() < position_values(s.sensor.frame)) continue;
       to_measurement(s, d, detection_);
       PendingRow& r = add_measurement_row(detection_, port);
       r.detection = true;
@@ -275,29 +275,35 @@ class CsvSink final : public Component, public RunResultCodec {
   }
 
   void on_measurement(const Measurement& m, int port) override {
-    if (!include_measurements_ || !m.valid || m.value.size() < 3) return;
+    if (!include_measurements_ || !m.valid || m.value.size() < m.position_dim()) return;
     add_measurement_row(m, port);
     arrived(m.time);
     flush(false);
   }
 
-  // A measurement's cells: the Cartesian position (a spherical one converted) and, when
-  // Cartesian, the sigmas of its covariance diagonal.
+  // A measurement's cells: the Cartesian position (a spherical or polar one converted, a planar
+  // one in z = 0) and, when Cartesian or planar, the sigmas of its covariance diagonal.
   PendingRow& add_measurement_row(const Measurement& m, int port) {
     PendingRow& r = pending_.emplace_back();
     r.time = m.time;
     r.port = port;
     r.measurement = true;
     r.sigma_missing = 0;
-    if (m.frame == Frame::Cartesian) {
-      r.value.head<3>() = m.value.head<3>();
-      r.has_sigma = m.covariance.rows() >= 3 && m.covariance.cols() >= 3;
-      for (int i = 0; i < 3 && r.has_sigma; ++i) {
+    if (m.frame == Frame::Cartesian || m.frame == Frame::Planar) {
+      // A planar position lies in z = 0: its z and z sigma are 0, not unknown.
+      const int k = m.position_dim();
+      r.value.head<3>() = measured_position(m);
+      r.has_sigma = m.covariance.rows() >= k && m.covariance.cols() >= k;
+      if (r.has_sigma) r.sigma.setZero();
+      for (int i = 0; i < k && r.has_sigma; ++i) {
         const double v = m.covariance(i, i);
         r.sigma(i) = std::sqrt(v);
         if (v < 0.0) r.sigma_missing |= static_cast<std::uint8_t>(1u << i);
       }
-      if (r.has_sigma) r.covariance.topLeftCorner<3, 3>() = m.covariance.topLeftCorner(3, 3);
+      if (r.has_sigma) {
+        r.covariance.topLeftCorner<3, 3>().setZero();
+        r.covariance.topLeftCorner(k, k) = m.covariance.topLeftCorner(k, k);
+      }
     } else {
       r.value.head<3>() = measured_position(m);
     }

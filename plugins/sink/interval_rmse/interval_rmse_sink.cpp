@@ -67,10 +67,8 @@ class IntervalRmseSink final : public Component, public FieldListCodec<IntervalR
   }
 
   void on_measurement(const Measurement& m, int) override {
-    if (!m.valid || m.value.size() < 3 || !m.value.head<3>().allFinite()) return;
-    const Vec3 p = m.frame == Frame::Cartesian
-                       ? Vec3(m.value.head<3>())
-                       : measured_position(m);
+    if (!m.valid || m.value.size() < m.position_dim() || !m.value.head(m.position_dim()).allFinite()) return;
+    const Vec3 p = measured_position(m);
     measurements_.push_back({m.time, 0, true, p});
   }
 

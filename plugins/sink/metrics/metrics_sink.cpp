@@ -108,10 +108,8 @@ class MetricsSink final : public Component, public FieldListCodec<MetricsRunResu
   }
 
   void on_measurement(const Measurement& m, int) override {
-    if (!m.valid || m.value.size() < 3) return;
-    const Vec3 p = m.frame == Frame::Cartesian
-                       ? Vec3(m.value.head<3>())
-                       : measured_position(m);
+    if (!m.valid || m.value.size() < m.position_dim()) return;
+    const Vec3 p = measured_position(m);
     if (streaming_) return scorer_.on_measurement(m.time, p);
     measurements_.push_back({m.time, p});
   }

@@ -75,9 +75,9 @@ class SceneSink final : public Component, public FieldListCodec<SceneRunResult> 
     for (const Detection& d : scan.detections) {
       const bool clutter = d.origin == kOriginClutter;
       if (clutter && index % rec_.clutter_stride != 0) continue;
-      if (d.value.size() < 3) continue;
+      if (d.value.size() < position_values(scan.sensor.frame)) continue;
       to_measurement(scan, d, m);
-      const Vec3 p = m.frame == Frame::Cartesian ? Vec3(m.value.head<3>()) : measured_position(m);
+      const Vec3 p = measured_position(m);
       const double origin = clutter ? kClutter : d.origin == kOriginUnknown ? kUnknownOrigin : double(d.origin);
       keep(*s, {scan.time, origin, double(index), {p.x(), p.y(), p.z()}});
     }

@@ -62,16 +62,12 @@ class TrackSink final : public Component, public FieldListCodec<TrackRunResult> 
 
   void on_measurement(const Measurement& m, int port) override {
     Stream* s = stream(port, ItemKind::Measurement);
-    if (!s || !m.valid || m.value.size() < 3) return;
-    Vec3 p;
+    const int k = m.position_dim();
+    if (!s || !m.valid || m.value.size() < k) return;
+    const Vec3 p = measured_position(m);
     Vec3 sigma = Vec3::Constant(kNaN);
-    if (m.frame == Frame::Cartesian) {
-      p = m.value.head<3>();
-      if (m.covariance.rows() >= 3 && m.covariance.cols() >= 3)
-        for (int i = 0; i < 3; ++i) sigma(i) = m.covariance(i, i) >= 0.0 ? std::sqrt(m.covariance(i, i)) : kNaN;
-    } else {
-      p = measured_position(m);
-    }
+    if ((m.frame == Frame::Cartesian || m.frame == Frame::Planar) && m.covariance.rows() >= k && m.covariance.cols() >= k)
+      for (int i = 0; i < k; ++i) sigma(i) = m.covariance(i, i) >= 0.0 ? std::sqrt(m.covariance(i, i)) : kNaN;
     s->points.push_back({m.time, kNaN, {p.x(), p.y(), p.z()}, {kNaN, kNaN, kNaN}, {sigma.x(), sigma.y(), sigma.z()}});
   }
 

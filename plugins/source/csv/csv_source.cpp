@@ -42,7 +42,7 @@ std::string format_number(double v) {
   return number_text::general(v, 10);
 }
 
-enum class LogFrame { Spherical, Cartesian };
+enum class LogFrame { Spherical, Cartesian, Polar, Planar };
 enum class TimeUnit { Second, Millisecond };
 enum class LengthUnit { Metre, Kilometre };
 enum class AngleUnit { Degree, Radian, Milliradian };
@@ -338,8 +338,14 @@ class CsvSource final : public Generator {
       for (const char* name : {"target_column", "vx_column", "vy_column", "vz_column"})
         if (p.given(name)) throw p.error(name, "applies only to content: truth");
     }
-    const bool cartesian = p.choice<LogFrame>("frame") == LogFrame::Cartesian;
-    frame_ = cartesian ? Frame::Cartesian : Frame::Spherical;
+    const LogFrame log_frame = p.choice<LogFrame>("frame");
+    // Positions in x, y (, z): Cartesian and planar; in range, azimuth (, elevation): spherical and polar.
+    const bool cartesian = log_frame == LogFrame::Cartesian || log_frame == LogFrame::Planar;
+    frame_ = log_frame == LogFrame::Cartesian ? Frame::Cartesian
+             : log_frame == LogFrame::Planar  ? Frame::Planar
+             : log_frame == LogFrame::Polar   ? Frame::Polar
+                                              : Frame::Spherical;
+    positions_ = position_values(frame_);
     // A parameter of the other frame would be silently ignored; say so instead.
     const std::vector<const char*> spherical_only = {"range_column", "azimuth_column", "elevation_column",
                                                      "range_unit",   "angle_unit",     "sigma_range",
@@ -348,8 +354,17 @@ class CsvSource final : public Generator {
                                                      "sigma_position"};
     for (const char* name : cartesian ? spherical_only : cartesian_only)
       if (p.given(name))
-        throw p.error(name, std::string("applies only to frame: ") + (cartesian ? "spherical" : "cartesian") +
+        throw p.error(name, std::string("applies only to frame: ") + (cartesian ? "spherical or polar" : "cartesian or planar") +
                                 ", and this source reads frame: " + p.choice_word("frame"));
+    // The value a 2-D frame does not have.
+    const char* unmeasured = frame_ == Frame::Polar ? "elevation_column" : frame_ == Frame::Planar ? "z_column" : nullptr;
+    if (unmeasured && p.given(unmeasured))
+      throw p.error(unmeasured, std::string("frame: ") + p.choice_word("frame") + " has no " +
+                                    (frame_ == Frame::Polar ? "elevation (a 2-D radar)" : "z (a planar sensor)"));
+    if (frame_ == Frame::Polar && p.given("sigma_elevation"))
+      throw p.error("sigma_elevation", "frame: polar has no elevation (a 2-D radar)");
+    if (frame_ == Frame::Planar && p.has("range_rate_column"))
+      throw p.error("range_rate_column", "frame: planar has no range rate (a position sensor of the plane)");
     if (p.given("sigma_range_rate") && !p.has("range_rate_column"))
       throw p.error("sigma_range_rate", "applies only when range_rate_column names the range-rate column");
 
@@ -364,14 +379,14 @@ class CsvSource final : public Generator {
     if (cartesian) {
       value_[0] = column("x_column");
       value_[1] = column("y_column");
-      value_[2] = column("z_column");
+      if (positions_ == 3) value_[2] = column("z_column");
       const double length = length_scale(p.choice<LengthUnit>("position_unit"));
       scale_[0] = scale_[1] = scale_[2] = length;
       rdot_scale_ = length;
     } else {
       value_[0] = column("range_column");
       value_[1] = column("azimuth_column");
-      value_[2] = column("elevation_column");
+      if (positions_ == 3) value_[2] = column("elevation_column");
       const double length = length_scale(p.choice<LengthUnit>("range_unit"));
       const double angle = angle_scale(p.choice<AngleUnit>("angle_unit"));
       scale_[0] = length;
@@ -393,22 +408,25 @@ class CsvSource final : public Generator {
     }
 
     Measurement& m = prototype_;
-    m.frame = cartesian ? Frame::Cartesian : Frame::Spherical;
+    m.frame = frame_;
     m.azimuth = p.choice<AzimuthConvention>("azimuth_convention");
     m.sensor = static_cast<std::uint32_t>(p.integer("sensor_id"));
     m.sensor_position = p.vec3("position");
     m.has_range_rate = !range_rate_.name.empty();
-    const int n = m.has_range_rate ? 4 : 3;
+    const int n = positions_ + (m.has_range_rate ? 1 : 0);
     m.value = MeasVec::Zero(n);
     m.covariance = MeasCov::Zero(n, n);
     if (cartesian) {
       const double s = p.real("sigma_position");
-      m.covariance.diagonal().head<3>().setConstant(s * s);
+      for (int i = 0; i < positions_; ++i) m.covariance(i, i) = s * s;
     } else {
       const double sr = p.real("sigma_range"), sa = p.real("sigma_azimuth"), se = p.real("sigma_elevation");
-      m.covariance.diagonal().head<3>() << sr * sr, sa * sa, se * se;
+      m.covariance(0, 0) = sr * sr;
+      m.covariance(1, 1) = sa * sa;
+      if (positions_ == 3) m.covariance(2, 2) = se * se;
     }
-    if (m.has_range_rate) m.covariance(3, 3) = p.real("sigma_range_rate") * p.real("sigma_range_rate");
+    if (m.has_range_rate)
+      m.covariance(positions_, positions_) = p.real("sigma_range_rate") * p.real("sigma_range_rate");
   }
 
   std::string at(int line) const { return file_ + ":" + std::to_string(line) + ": "; }
@@ -614,24 +632,24 @@ class CsvSource final : public Generator {
       remember_time(line, fields, t);
       return true;
     }
-    for (int k = 0; k < 3; ++k) {
+    for (int k = 0; k < positions_; ++k) {
       double v = 0.0;
       if (!real(value_[k], v)) return false;
       m.value(k) = v * scale_[k];
       // Finite in the file's unit is not enough: 1e306 km is infinite in metres.
       if (!std::isfinite(m.value(k))) return complain("", "value overflows when converted to SI", value_[k]);
     }
-    if (m.frame == Frame::Spherical) {
+    if (has_azimuth(m.frame)) {
       if (m.value(0) < 0.0) return complain("", "negative range", value_[0]);
-      if (std::fabs(m.value(2)) > std::numbers::pi / 2 * (1 + 1e-12))
+      if (m.frame == Frame::Spherical && std::fabs(m.value(2)) > std::numbers::pi / 2 * (1 + 1e-12))
         return complain("", "elevation beyond +-90 deg", value_[2]);
       m.value(1) = wrap_angle(m.value(1));
     }
     if (range_rate_.read()) {
       double v = 0.0;
       if (!real(range_rate_, v)) return false;
-      m.value(3) = v * rdot_scale_;
-      if (!std::isfinite(m.value(3))) return complain("", "value overflows when converted to SI", range_rate_);
+      m.value(positions_) = v * rdot_scale_;
+      if (!std::isfinite(m.value(positions_))) return complain("", "value overflows when converted to SI", range_rate_);
     }
     if (snr_.read()) {
       if (!real(snr_, m.snr_db)) return false;
@@ -695,6 +713,7 @@ class CsvSource final : public Generator {
   bool skip_bad_rows_ = false;
   std::string file_;
   Content content_ = Content::Measurements;
+  int positions_ = 3;  // position values per row: 3, or 2 for the polar and planar frames
   Column time_, value_[3], range_rate_, snr_, mode_, valid_, sensor_, scan_id_, origin_, target_, velocity_[3];
   double time_scale_ = 1.0, scale_[3] = {1.0, 1.0, 1.0}, rdot_scale_ = 1.0;
   Measurement prototype_;
@@ -731,16 +750,21 @@ std::vector<ParamSpec> csv_params() {
   using P = ParamSpec;
   return {
       P::string("path", "CSV file; a relative path is relative to the pipeline file's folder").req(),
-      P::choice<LogFrame>("frame", {{LogFrame::Spherical, "spherical"}, {LogFrame::Cartesian, "cartesian"}},
-                          "what the rows hold: range/azimuth/elevation or x/y/z ENU")
+      P::choice<LogFrame>("frame",
+                          {{LogFrame::Spherical, "spherical"},
+                           {LogFrame::Cartesian, "cartesian"},
+                           {LogFrame::Polar, "polar"},
+                           {LogFrame::Planar, "planar"}},
+                          "what the rows hold: range/azimuth/elevation, x/y/z ENU, a 2-D radar's range/azimuth "
+                          "(polar), or a planar sensor's x/y (planar)")
           .def("spherical"),
       P::string("time_column", "column with the measurement time").def("time"),
-      P::string("range_column", "spherical: column with the range").def("range"),
-      P::string("azimuth_column", "spherical: column with the azimuth").def("azimuth"),
+      P::string("range_column", "spherical, polar: column with the range").def("range"),
+      P::string("azimuth_column", "spherical, polar: column with the azimuth").def("azimuth"),
       P::string("elevation_column", "spherical: column with the elevation").def("elevation"),
       P::string("range_rate_column", "column with the range rate (length unit per second); read only if given"),
-      P::string("x_column", "cartesian: column with x (east)").def("x"),
-      P::string("y_column", "cartesian: column with y (north)").def("y"),
+      P::string("x_column", "cartesian, planar: column with x (east)").def("x"),
+      P::string("y_column", "cartesian, planar: column with y (north)").def("y"),
       P::string("z_column", "cartesian: column with z (up)").def("z"),
       P::string("snr_column", "column with the signal-to-noise ratio in dB; read only if given"),
       P::string("mode_column", "column with the track mode: beacon or skin (any case), anything else is unknown"),
@@ -763,17 +787,17 @@ std::vector<ParamSpec> csv_params() {
                                               "space (m3, or m rad2 for spherical; default: not stated)").at_least(0),
       P::choice<TimeUnit>("time_unit", {{TimeUnit::Second, "s"}, {TimeUnit::Millisecond, "ms"}}, "unit of the time column")
           .def("s"),
-      length_unit_param("range_unit", "spherical: unit of range (and range rate per second)"),
+      length_unit_param("range_unit", "spherical, polar: unit of range (and range rate per second)"),
       P::choice<AngleUnit>("angle_unit",
                            {{AngleUnit::Degree, "deg"}, {AngleUnit::Radian, "rad"}, {AngleUnit::Milliradian, "mrad"}},
-                           "spherical: unit of azimuth and elevation")
+                           "spherical, polar: unit of azimuth and elevation")
           .def("deg"),
-      length_unit_param("position_unit", "cartesian: unit of x, y, z (and range rate per second)"),
-      P::real("sigma_range", dim::length, "spherical: range noise standard deviation").def("10 m").positive(),
-      P::real("sigma_azimuth", dim::angle, "spherical: azimuth noise standard deviation").def("1 mrad").positive(),
+      length_unit_param("position_unit", "cartesian, planar: unit of x, y, z (and range rate per second)"),
+      P::real("sigma_range", dim::length, "spherical, polar: range noise standard deviation").def("10 m").positive(),
+      P::real("sigma_azimuth", dim::angle, "spherical, polar: azimuth noise standard deviation").def("1 mrad").positive(),
       P::real("sigma_elevation", dim::angle, "spherical: elevation noise standard deviation").def("1 mrad").positive(),
       P::real("sigma_range_rate", dim::velocity, "range-rate noise standard deviation").def("1 m/s").positive(),
-      P::real("sigma_position", dim::length, "cartesian: noise standard deviation of each of x, y, z")
+      P::real("sigma_position", dim::length, "cartesian, planar: noise standard deviation of each position value")
           .def("10 m")
           .positive(),
       P::real_list("position", dim::length, "sensor position in the ENU frame [x, y, z]", 3).def("[0, 0, 0]"),
@@ -809,7 +833,10 @@ void register_components(Registrar& r) {
           "(NaN: give the associator its own). Metrics add scans.\n"
           "content: truth replays a truth log (frame: cartesian): per row one Truth of target target_column at "
           "x, y, z (position_unit) with velocity vx, vy, vz when those columns are given (else 0) and acceleration 0, "
-          "in time order, so a recorded run (e.g. GPS or ADS-B reference positions) can be scored by the sinks.";
+          "in time order, so a recorded run (e.g. GPS or ADS-B reference positions) can be scored by the sinks.\n"
+          "frame: polar reads a 2-D surveillance radar's rows (range_column, azimuth_column; no elevation), frame: "
+          "planar a planar position sensor's (x_column, y_column; no z, no range rate): two position values per "
+          "row, sigma_range/sigma_azimuth or sigma_position for their covariance.";
   d.params = csv_params();
   d.min_inputs = 0;
   d.max_inputs = 0;

@@ -633,3 +633,32 @@ TEST_CASE("content truth replays targets with their velocities") {
   CHECK_THAT(refusal(file, "frame: cartesian, target_column: target"), Catch::Contains("only to content: truth"));
   CHECK_THAT(refusal(file, "content: truth, frame: cartesian, target_column: id"), Catch::Contains("no column 'id'"));
 }
+
+// A 2-D radar's log (frame: polar): range and azimuth only, azimuth wrapped, range rate after them;
+// a planar sensor's log (frame: planar): x and y. Their 3-D columns and parameters are refused.
+TEST_CASE("polar and planar logs hold two position values") {
+  TempDir dir;
+  const std::string polar = dir.write("polar.csv", "time,range,azimuth,rdot\n0,12,350,-3\n1,12.1,10,-3\n");
+  const auto ms = read_all(polar, "frame: polar, range_unit: km, range_rate_column: rdot, sigma_range: 30 m");
+  REQUIRE(ms.size() == 2);
+  CHECK(ms[0].frame == Frame::Polar);
+  REQUIRE(ms[0].value.size() == 3);
+  CHECK(ms[0].value[0] == Approx(12e3));
+  CHECK(ms[0].value[1] == Approx(-10 * kDeg));
+  CHECK(ms[0].value[2] == Approx(-3e3));  // km per second
+  REQUIRE(ms[0].covariance.rows() == 3);
+  CHECK(ms[0].covariance(0, 0) == Approx(900.0));
+  CHECK(ms[0].has_range_rate);
+  const std::string planar = dir.write("planar.csv", "time,x,y\n0,100,-200\n");
+  const auto ps = read_all(planar, "frame: planar, sigma_position: 5 m");
+  REQUIRE(ps.size() == 1);
+  CHECK(ps[0].frame == Frame::Planar);
+  REQUIRE(ps[0].value.size() == 2);
+  CHECK(ps[0].value[1] == -200.0);
+  REQUIRE(ps[0].covariance.rows() == 2);
+  CHECK(ps[0].covariance(1, 1) == 25.0);
+  CHECK_THAT(refusal(polar, "frame: polar, elevation_column: el"), Catch::Contains("no elevation"));
+  CHECK_THAT(refusal(planar, "frame: planar, z_column: z"), Catch::Contains("no z"));
+  CHECK_THAT(refusal(planar, "frame: planar, range_rate_column: rdot"), Catch::Contains("no range rate"));
+  CHECK_THAT(refusal(planar, "frame: planar, sigma_range: 3 m"), Catch::Contains("spherical or polar"));
+}

@@ -160,17 +160,23 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
 
  private:
   // A scan the estimator cannot take is a data error (the wiring was checked; the values are the data's).
-  void check(const Scan& s) const {
+  void check(const Scan& s) {
     const MeasurementSpec& spec = prototype_->measurement_spec();
-    if (s.sensor.frame != spec.frame)
-      throw DataError("tracker.multi (node '" + node_ + "'): its estimator takes " + to_string(spec.frame) +
+    if (!(spec.frames & mask(s.sensor.frame)))
+      throw DataError("tracker.multi (node '" + node_ + "'): its estimator takes " + frame_names(spec.frames) +
                       " detections, but the scan at t=" + std::to_string(s.time) + " s is " + to_string(s.sensor.frame));
     if (!s.sensor.sensor_level && !spec.tilted_sensors)
       throw DataError("tracker.multi (node '" + node_ + "'): the scan at t=" + std::to_string(s.time) +
                       " s comes from a tilted sensor, which its estimator does not turn into");
+    // The estimator's own checks (Estimator::check) of the scan's first detection: what they test is
+    // the sensor's (a 2-D radar's tilt, say), which the scan's detections share.
+    if (!s.detections.empty()) {
+      to_measurement(s, s.detections.front(), m_);
+      prototype_->check(m_);
+    }
     for (const Detection& d : s.detections) {
       const int n = static_cast<int>(d.value.size());
-      if (n != (d.has_range_rate ? 4 : 3) || d.covariance.rows() != n || d.covariance.cols() != n ||
+      if (n != position_values(s.sensor.frame) + (d.has_range_rate ? 1 : 0) || d.covariance.rows() != n || d.covariance.cols() != n ||
           !d.value.allFinite() || !d.covariance.allFinite())
         throw DataError("tracker.multi (node '" + node_ + "'): a detection of the scan at t=" + std::to_string(s.time) +
                         " s has " + std::to_string(n) + " values and a " + std::to_string(d.covariance.rows()) + "x" +
@@ -178,13 +184,14 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
     }
   }
 
-  int dimension(const Detection& d) const {
+  int dimension(const SensorFrame& f, const Detection& d) const {
+    const int positions = position_values(f.frame);
     switch (prototype_->measurement_spec().range_rate) {
-      case RangeRateUse::Use: return 4;
-      case RangeRateUse::Auto: return d.has_range_rate ? 4 : 3;
+      case RangeRateUse::Use: return positions + 1;
+      case RangeRateUse::Auto: return d.has_range_rate ? positions + 1 : positions;
       case RangeRateUse::Ignore: break;
     }
-    return 3;
+    return positions;
   }
 
   // The estimator's R from detection d (its leading dim x dim block).
@@ -206,7 +213,7 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
       t.can_predict = false;
       if (!s.detections.empty()) {
         const Detection& d = s.detections.front();
-        set_R(*t.estimator, d, dimension(d));
+        set_R(*t.estimator, d, dimension(s.sensor, d));
         t.can_predict = t.estimator->predict_measurement(s.sensor, t.estimator->measurement_noise(), t.predicted);
       }
       views_.push_back(t.view());
@@ -238,7 +245,7 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
       clear_innovation(t.published.estimate);
       if (assigned_[i] >= 0) {
         const Detection& d = s.detections[static_cast<size_t>(assigned_[i])];
-        const int dim = dimension(d);
+        const int dim = dimension(s.sensor, d);
         to_measurement(s, d, m_);
         set_R(*t.estimator, d, dim);
         used = t.estimator->update(m_, dim);
@@ -317,14 +324,14 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
       t.predicted = PredictedMeasurement{};
       t.can_predict = false;
       t.time = st.first.time;
-      const int dim1 = dimension(st.first);
+      const int dim1 = dimension(st.first, st.first);
       set_R(*t.estimator, st.first, dim1);
       bool formed = t.estimator->initiate(st.first, dim1);
       if (!formed) {
         const Detection& d = s.detections[static_cast<size_t>(st.second)];
         to_measurement(s, d, m_);
         t.time = s.time;
-        const int dim2 = dimension(d);
+        const int dim2 = dimension(s.sensor, d);
         set_R(*t.estimator, d, dim2);
         formed = t.estimator->initiate(m_, dim2);
       }

@@ -92,7 +92,7 @@ class NanEstimates final : public Filter {
 class NanEstimator final : public Estimator {
  public:
   explicit NanEstimator(const Params& p)
-      : Estimator(MeasurementSpec{Frame::Cartesian, RangeRateUse::Ignore, {}}), at_(p.real("at")) {}
+      : Estimator(MeasurementSpec{mask(Frame::Cartesian), RangeRateUse::Ignore, {}}), at_(p.real("at")) {}
   NoiseHandles noise() override { return {}; }
   StateLayout layout() const override {
     static constexpr StateComponent kLayout[] = {{"x", "m"}, {"y", "m"}, {"z", "m"},

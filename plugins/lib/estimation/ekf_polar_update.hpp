@@ -1,0 +1,88 @@
+// Purpose: the EKF measurement update of a Cartesian state on a 2-D surveillance radar's [r, az(, rdot)] (Frame::Polar, filter.ekf): the spherical model's range, azimuth (and range-rate) rows, structured Joseph update.
+#pragma once
+
+#include "ekf_radar_update.hpp"
+
+#include <trackflow/geometry.hpp>
+#include <trackflow/items.hpp>
+#include <trackflow/kalman.hpp>
+#include <trackflow/spherical_measurement.hpp>
+
+#include <Eigen/Core>
+
+namespace trackflow::cartesian_filter {
+
+// A 2-D radar measures the spherical model's range and azimuth (and range rate) and no
+// elevation: h = rows {r, az(, rdot)} of spherical_measurement (spherical_measurement.hpp), its
+// Jacobian the same rows of the analytic one. M = 2 ([r, az]) or 3 ([r, az, rdot]). The range is
+// the slant range |d| of the state; a track started from polar points lies in the radar's
+// horizontal plane (cartesian_radar_state.hpp), where it equals the ground range.
+// Near the vertical of the radar (horizontal range below kZenithFraction r, only off the plane) the
+// azimuth row is dropped as in ekf_radar_update; there is no curvature conditioning (its derivation
+// is for [r, az, el]).
+template <int N, int M>
+EkfOutcome ekf_polar_update(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double, N, N>& P, const int idx[6],
+                            const Measurement& m, const Eigen::Matrix<double, M, M>& R_measured, EkfInnovation<M>& out) {
+  static_assert(M == 2 || M == 3);
+  constexpr int MS = M + 1;  // the spherical model with elevation: [r, az, el(, rdot)]
+  using MatM = Eigen::Matrix<double, M, M>;
+  out.azimuth_dropped = out.azimuth_deweighted = false;
+  const Vec3 d = frame_to_sensor(m, Vec3(x(idx[0]), x(idx[1]), x(idx[2])) - m.sensor_position);
+  const Vec3 v = frame_to_sensor(m, Vec3(x(idx[3]), x(idx[4]), x(idx[5])));
+  SphericalJacobian<MS> Js;
+  SphericalVec<MS> hs;
+  const SphericalSingularity sing = spherical_measurement_with_jacobian<MS>(d, v, m.azimuth, hs, Js);
+  if (sing == SphericalSingularity::AtSensor) return EkfOutcome::AtSensor;
+  // Rows r, az (, rdot) of the spherical model: measurement row k is spherical row row_of[k].
+  constexpr int row_of[3] = {0, 1, 3};
+  Eigen::Matrix<double, M, 6> J;
+  Eigen::Matrix<double, M, 1> h;
+  for (int k = 0; k < M; ++k) {
+    J.row(k) = Js.row(row_of[k]);
+    h(k) = hs(row_of[k]);
+  }
+  Eigen::Matrix<double, M, 1> nu = m.value.template head<M>() - h;
+  nu(1) = wrap_angle(nu(1));
+  MatM R = R_measured;
+  if (sing == SphericalSingularity::Zenith) {  // an infinitely uncertain azimuth, as in condition_near_zenith
+    out.azimuth_dropped = true;
+    const double raz = R(1, 1);
+    J.row(1).setZero();
+    nu(1) = 0.0;
+    R.row(1).setZero();
+    R.col(1).setZero();
+    R(1, 1) = raz > 0.0 ? raz : 1.0;
+  }
+  if (!m.sensor_level) {  // dh/dx_frame = dh/dd_sensor A'
+    const Mat3 At = m.sensor_axes.transpose();
+    for (int k = 0; k < M; ++k) {
+      const Eigen::RowVector3d jp = J.template block<1, 3>(k, 0) * At;
+      J.template block<1, 3>(k, 0) = jp;
+      if (k == 2) {
+        const Eigen::RowVector3d jv = J.template block<1, 3>(k, 3) * At;
+        J.template block<1, 3>(k, 3) = jv;
+      }
+    }
+  }
+  // Rows r and az depend on the position only; the range rate's also on the velocity.
+  Eigen::Matrix<double, N, M> PHt;
+  for (int k = 0; k < M; ++k)
+    for (int r = 0; r < N; ++r) {
+      double s = P(r, idx[0]) * J(k, 0) + P(r, idx[1]) * J(k, 1) + P(r, idx[2]) * J(k, 2);
+      if (k == 2) s += P(r, idx[3]) * J(k, 3) + P(r, idx[4]) * J(k, 4) + P(r, idx[5]) * J(k, 5);
+      PHt(r, k) = s;
+    }
+  MatM& S = out.S;
+  for (int k = 0; k < M; ++k)
+    for (int l = k; l < M; ++l) {
+      const int c = l == 2 ? 6 : 3;
+      double s = R(l, k);
+      for (int j = 0; j < c; ++j) s += J(l, j) * PHt(idx[j], k);
+      S(l, k) = s;
+    }
+  out.nu = nu;
+  if (joseph_update_cross<N, M>(x, P, nu, PHt, S, out.nis, nullptr, &out.det_S)) return EkfOutcome::Used;
+  return EkfOutcome::NotPositiveDefinite;
+}
+
+}  // namespace trackflow::cartesian_filter
