@@ -229,6 +229,17 @@ std::vector<std::string> converter_types(const PluginRegistry& registry) {
   return out;
 }
 
+// The installed types of `kind` that accept a frame of `frames` (for a refusal's hint).
+std::vector<std::string> types_taking(const PluginRegistry& registry, ComponentKind kind, FrameMask frames) {
+  std::vector<std::string> out;
+  for (const auto& t : registry.types())
+    if (t.decl.kind == kind && (t.decl.accepts & mask(ItemKind::Measurement)) && t.decl.accepts_frames != kAnyFrame &&
+        (t.decl.accepts_frames & frames))
+      out.push_back(t.decl.type);
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
 // A measurement wire whose frames do not meet is refused before anything runs.
 void check_frames(const Graph& g, const GraphInstance& inst, const PluginRegistry& registry) {
   for (size_t i = 0; i < g.nodes.size(); ++i) {
@@ -242,8 +253,10 @@ void check_frames(const Graph& g, const GraphInstance& inst, const PluginRegistr
       std::string hint;
       if ((d.accepts_frames & mask(Frame::Cartesian)) && (produced & mask(Frame::Spherical)))
         hint = "; insert a converter between them (" + join(converter_types(registry)) + ")";
-      else if (d.accepts_frames & mask(Frame::Spherical))
+      else if ((d.accepts_frames & mask(Frame::Spherical)) && (produced & mask(Frame::Cartesian)))
         hint = "; wire it to the radar's spherical output instead";
+      else if (const std::vector<std::string> takers = types_taking(registry, d.kind, produced); !takers.empty())
+        hint = std::string("; the ") + to_string(d.kind) + "s that take them: " + join(takers);
       throw ConfigError("input '" + up.config.id + "' (" + up.config.type + ") produces " + frame_names(produced) +
                             " measurements, but " + n.config.type + " takes " + frame_names(d.accepts_frames) +
                             " measurements" + hint,

@@ -16,7 +16,7 @@ radar_nodes() { truth_radar contract 4 3 20; }
 YAML
 } > "$TMP/radar_kalman.yaml"
 expect_run "sim.radar -> filter.kalman refused at the input line" 2 \
-  "radar_kalman.yaml:15:12: node 'kf': input 'radar' \(sim.radar\) produces spherical measurements, but filter.kalman takes cartesian measurements; insert a converter between them \(convert.classical" \
+  "radar_kalman.yaml:15:12: node 'kf': input 'radar' \(sim.radar\) produces spherical measurements, but filter.kalman takes cartesian/planar \(x-y\) measurements; insert a converter between them \(convert.classical" \
   -- "$TF" validate "$TMP/radar_kalman.yaml"
 
 # 2. Adapters whose noise the filter does not have.

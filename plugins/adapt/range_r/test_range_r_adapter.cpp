@@ -128,7 +128,7 @@ nodes:
   } catch (const ConfigError& e) {
     const std::string what = e.message();
     CHECK_THAT(what, Catch::Contains("bad.yaml:13:") && Catch::Contains("'arr'") && Catch::Contains("spherical") &&
-                         Catch::Contains("cartesian_position"));
+                         Catch::Contains("receives cartesian measurements"));
   }
   CHECK_THROWS_WITH(test::make("adapt.range_r", "{ alpha: 0 urad2, beta: 0 urad2, reference_range: 1 km }"),
                     Catch::Contains("beta"));
