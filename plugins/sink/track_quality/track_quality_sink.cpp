@@ -126,7 +126,7 @@ class TrackQualitySink final : public Component, public FieldListCodec<QualityRu
   }
 
   // SIAP positional and velocity accuracy terms of truth i paired with track j: Euclidean errors in
-  // x-y-z, or in x-y with dimensions: 2 (docs/multi-target.md).
+  // x-y-z, or in x-y with dimensions: 2 (docs/multi-target-metrics.md, SIAP accuracy).
   void add_pair_errors(std::size_t i, std::size_t j) {
     const Vec3 dp = steps_in_.track_positions()[j] - steps_in_.truth_positions()[i];
     const Vec3 dv = steps_in_.track_velocities()[j] - steps_in_.truth_velocities()[i];
