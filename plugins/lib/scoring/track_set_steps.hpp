@@ -1,4 +1,4 @@
-// Purpose: the stream bookkeeping shared by the sinks that score each TrackSet against the truths of exactly its time (sink.gospa, sink.ospa): truth batches, the selected track positions, the per-run counters, the run means with their Student-t interval, and the per-step means over runs.
+// Purpose: the stream bookkeeping shared by the sinks that score each TrackSet against the truths of exactly its time (sink.gospa, sink.ospa, sink.track_quality): truth batches, the selected track positions and velocities, the per-run counters, the run means with their Student-t interval, and the per-step means over runs.
 #pragma once
 
 #include "scoring/track_set_sink.hpp"
@@ -54,7 +54,8 @@ struct TrackSetCounts {
 // Streams: truths of one time are kept until the next time's; each TrackSet is paired on arrival
 // with the truths of exactly its time stamp (they arrive first, in time order). Reads the
 // parameters of track_set_params(). Buffers keep their capacity between scans and runs. Each
-// kept truth and track has its id (truth target, track id) at the same index as its position.
+// kept truth and track has its id (truth target, track id) and its velocity at the same index as
+// its position (only the position is checked for finiteness).
 class TrackSetSteps {
  public:
   explicit TrackSetSteps(const Params& p)
@@ -71,6 +72,7 @@ class TrackSetSteps {
     truth3_.clear();
     truth2_.clear();
     truth_ids_.clear();
+    truth_vel_.clear();
     have_batch_ = batch_used_ = false;
     first_set_ = std::numeric_limits<double>::quiet_NaN();
   }
@@ -84,6 +86,7 @@ class TrackSetSteps {
       truth3_.clear();
       truth2_.clear();
       truth_ids_.clear();
+      truth_vel_.clear();
     }
     if (!t.position.allFinite()) {
       ++counts_.non_finite_truths;
@@ -96,6 +99,7 @@ class TrackSetSteps {
     truth_ids_.push_back(t.target);
     truth3_.push_back(t.position);
     truth2_.push_back(t.position.head<2>());
+    truth_vel_.push_back(t.velocity);
   }
 
   // true when `set` is to be scored: then truths() and tracks() hold its time's positions.
@@ -110,6 +114,7 @@ class TrackSetSteps {
     track3_.clear();
     track2_.clear();
     track_ids_.clear();
+    track_vel_.clear();
     for (const TrackEstimate& te : set.tracks) {
       if (!status_selected(statuses_, te.status) || !te.estimate.initialised) continue;
       const Vec3 pos = te.estimate.enu.head<3>();
@@ -124,12 +129,14 @@ class TrackSetSteps {
       track_ids_.push_back(te.id);
       track3_.push_back(pos);
       track2_.push_back(pos.head<2>());
+      track_vel_.push_back(te.estimate.enu.tail<3>());
     }
     if (!truth_now) {
       ++counts_.steps_without_truth;
       truth3_.clear();
       truth2_.clear();
       truth_ids_.clear();
+      truth_vel_.clear();
     }
     return true;
   }
@@ -144,6 +151,11 @@ class TrackSetSteps {
   std::size_t tracks() const { return track3_.size(); }
   std::span<const std::uint64_t> truth_ids() const { return truth_ids_; }
   std::span<const std::uint64_t> track_ids() const { return track_ids_; }
+  // 3-D positions and velocities (ENU, m and m/s) whatever dimensions says; index as the ids.
+  std::span<const Eigen::Vector3d> truth_positions() const { return truth3_; }
+  std::span<const Eigen::Vector3d> track_positions() const { return track3_; }
+  std::span<const Eigen::Vector3d> truth_velocities() const { return truth_vel_; }
+  std::span<const Eigen::Vector3d> track_velocities() const { return track_vel_; }
 
   // f(truth positions, track positions) as spans of Eigen::Vector2d or Eigen::Vector3d, as dimensions asks.
   template <class F>
@@ -161,7 +173,7 @@ class TrackSetSteps {
   const bool planar_;
   const double skip_initial_;
   TrackSetCounts counts_;
-  std::vector<Eigen::Vector3d> truth3_, track3_;
+  std::vector<Eigen::Vector3d> truth3_, track3_, truth_vel_, track_vel_;
   std::vector<Eigen::Vector2d> truth2_, track2_;
   std::vector<std::uint64_t> truth_ids_, track_ids_;
   std::uint64_t id_limit_ = std::numeric_limits<std::uint64_t>::max();

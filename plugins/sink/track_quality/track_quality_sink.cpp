@@ -1,4 +1,4 @@
-// Purpose: sink.track_quality — how well a tracker's tracks follow the truths over time: completeness, spuriousness, identity swaps, track breaks, establishment time, tracks never on a target.
+// Purpose: sink.track_quality — how well a tracker's tracks follow the truths over time: completeness, spuriousness, identity swaps, track breaks, establishment time, tracks never on a target, SIAP positional and velocity accuracy.
 #include "memory/grow.hpp"
 #include "scoring/gospa.hpp"
 #include "scoring/track_set_sink.hpp"
@@ -27,12 +27,19 @@ struct QualityRunResult final : RunResult {
   std::uint64_t targets = 0, targets_established = 0;
   double establishment_time_sum = 0.0;  // over the established targets
   std::uint64_t tracks = 0, tracks_never_on_a_target = 0;
+  // SIAP accuracy over the truth-track pairs (their count: tracked_truth_steps): sums of the
+  // Euclidean position error and of its square; the same of the velocity error over the pairs
+  // whose velocity error is finite (velocity_pairs; a position is checked, a velocity is not).
+  double position_error_sum = 0.0, position_error_sq_sum = 0.0;
+  std::uint64_t velocity_pairs = 0;
+  double velocity_error_sum = 0.0, velocity_error_sq_sum = 0.0;
   std::uint64_t non_finite = 0, unscored_truth_steps = 0, steps_without_truth = 0, ids_out_of_range = 0;
   template <class Self, class F>
   static void fields(Self& r, F&& f) {
     f(r.steps, r.truth_steps, r.tracked_truth_steps, r.track_steps, r.spurious_track_steps, r.id_swaps, r.breaks,
-      r.targets, r.targets_established, r.establishment_time_sum, r.tracks, r.tracks_never_on_a_target, r.non_finite,
-      r.unscored_truth_steps, r.steps_without_truth, r.ids_out_of_range);
+      r.targets, r.targets_established, r.establishment_time_sum, r.tracks, r.tracks_never_on_a_target,
+      r.position_error_sum, r.position_error_sq_sum, r.velocity_pairs, r.velocity_error_sum, r.velocity_error_sq_sum,
+      r.non_finite, r.unscored_truth_steps, r.steps_without_truth, r.ids_out_of_range);
   }
 };
 
@@ -53,7 +60,7 @@ constexpr std::uint64_t kMaxId = 1u << 24;
 class TrackQualitySink final : public Component, public FieldListCodec<QualityRunResult> {
  public:
   explicit TrackQualitySink(const Params& p)
-      : gospa_(p.real("cutoff"), 2.0, 2.0), steps_in_(p) {
+      : gospa_(p.real("cutoff"), 2.0, 2.0), steps_in_(p), planar_(steps_in_.planar()) {
     steps_in_.refuse_ids_from(kMaxId);
   }
 
@@ -105,6 +112,7 @@ class TrackQualitySink final : public Component, public FieldListCodec<QualityRu
       if (ts.last_track != 0 && ts.last_track != id) ++run_.id_swaps;
       ts.last_track = id;
       ts.tracked_last_step = true;
+      add_pair_errors(i, static_cast<std::size_t>(j));
     }
     for (std::size_t j = 0; j < track_ids.size(); ++j) {
       TrackState& tr = track(track_ids[j]);
@@ -115,6 +123,21 @@ class TrackQualitySink final : public Component, public FieldListCodec<QualityRu
       if (track_on_target_[j]) tr.on_a_target = true;
       else ++run_.spurious_track_steps;
     }
+  }
+
+  // SIAP positional and velocity accuracy terms of truth i paired with track j: Euclidean errors in
+  // x-y-z, or in x-y with dimensions: 2 (docs/multi-target-metrics.md, SIAP accuracy).
+  void add_pair_errors(std::size_t i, std::size_t j) {
+    const Vec3 dp = steps_in_.track_positions()[j] - steps_in_.truth_positions()[i];
+    const Vec3 dv = steps_in_.track_velocities()[j] - steps_in_.truth_velocities()[i];
+    const double ep = planar_ ? dp.head<2>().norm() : dp.norm();
+    const double ev = planar_ ? dv.head<2>().norm() : dv.norm();
+    run_.position_error_sum += ep;
+    run_.position_error_sq_sum += ep * ep;
+    if (!std::isfinite(ev)) return;  // a tracker's non-finite velocity: left out of velocity accuracy
+    ++run_.velocity_pairs;
+    run_.velocity_error_sum += ev;
+    run_.velocity_error_sq_sum += ev * ev;
   }
 
   std::unique_ptr<RunResult> end_run() override {
@@ -150,6 +173,17 @@ class TrackQualitySink final : public Component, public FieldListCodec<QualityRu
     if (t.targets_established) s.metric("establishment_time", t.establishment_time_sum / double(t.targets_established), "s");
     s.metric("tracks_per_run", double(t.tracks) / runs);
     s.metric("tracks_never_on_a_target", ratio(double(t.tracks_never_on_a_target), double(t.tracks)));
+    // SIAP accuracies: pooled over all pairs of all steps and runs; none without a pair.
+    if (t.tracked_truth_steps) {
+      const double pairs = double(t.tracked_truth_steps);
+      s.metric("position_accuracy", t.position_error_sum / pairs, "m");
+      s.metric("position_accuracy_rms", std::sqrt(t.position_error_sq_sum / pairs), "m");
+    }
+    if (t.velocity_pairs) {
+      const double pairs = double(t.velocity_pairs);
+      s.metric("velocity_accuracy", t.velocity_error_sum / pairs, "m/s");
+      s.metric("velocity_accuracy_rms", std::sqrt(t.velocity_error_sq_sum / pairs), "m/s");
+    }
     s.metric("scored_steps", double(t.steps));
     s.metric("unscored_truth_steps", double(t.unscored_truth_steps));
     s.metric("steps_without_truth", double(t.steps_without_truth));
@@ -161,7 +195,12 @@ class TrackQualitySink final : public Component, public FieldListCodec<QualityRu
         " m); completeness: followed truth-steps / truth-steps; spuriousness: track-steps following no truth / "
         "track-steps; an id swap: a truth followed by a track other than the last one that followed it; a break: a "
         "followed truth not followed at its next step; establishment time: from a truth's first step to its first "
-        "followed one (the established ones)");
+        "followed one (the established ones); position_accuracy, velocity_accuracy: SIAP's mean Euclidean error "
+        "of the followed truth-steps (position in " + std::string(planar_ ? "x-y" : "x-y-z") +
+        "), _rms their root mean square");
+    if (t.velocity_pairs < t.tracked_truth_steps)
+      s.notes.push_back(std::to_string(t.tracked_truth_steps - t.velocity_pairs) +
+                        " followed truth-steps with a non-finite track velocity were left out of velocity_accuracy");
     if (t.non_finite || t.ids_out_of_range)
       s.notes.push_back("left out: " + std::to_string(t.non_finite) + " non-finite positions, " +
                         std::to_string(t.ids_out_of_range) + " ids of 2^24 or more");
@@ -185,6 +224,7 @@ class TrackQualitySink final : public Component, public FieldListCodec<QualityRu
 
   metrics::Gospa gospa_;
   scoring::TrackSetSteps steps_in_;
+  const bool planar_;
   QualityRunResult run_, total_;
   std::uint64_t runs_ = 0;
   std::vector<TargetState> targets_;
@@ -196,7 +236,7 @@ void register_components(Registrar& r) {
   ComponentDecl d;
   d.type = "sink.track_quality";
   d.kind = ComponentKind::Sink;
-  d.summary = "Track quality over time: completeness, spuriousness, identity swaps, track breaks, establishment time";
+  d.summary = "Track quality over time: completeness, spuriousness, identity swaps, track breaks, establishment time, SIAP accuracy";
   d.doc =
       "Inputs: a tracker's track sets and truth, e.g. inputs: [tracker, scenario]. At each TrackSet the truths of "
       "exactly its time are paired with the tracks of the chosen statuses by GOSPA's optimal assignment (pairs "
@@ -207,7 +247,10 @@ void register_components(Registrar& r) {
       "2008); track_breaks_per_run: times a followed truth is not followed at its next step while it still exists; "
       "establishment_time: mean time from a truth's first step to its first followed one, over the truths ever "
       "followed (targets_established: their fraction); tracks_never_on_a_target: fraction of the track ids that "
-      "never followed a truth. Sums are pooled over runs (ratios of sums). Truth and track ids index per-run "
+      "never followed a truth; position_accuracy and velocity_accuracy (SIAP, Votruba et al. 2001 as in Stone "
+      "Soup's SIAPMetrics): mean Euclidean position and velocity error (m, m/s; x-y only with dimensions: 2) of "
+      "the followed truth-steps' truth-track pairs, _rms their root mean square, none without a pair (SIAP's "
+      "ambiguity is 1 by construction of the one-to-one pairs: not published). Sums are pooled over runs (ratios of sums). Truth and track ids index per-run "
       "tables: ids of 2^24 or more are left out and counted. Identical for any --threads and under MPI.";
   d.params = {
       ParamSpec::real("cutoff", dim::length, "a track farther than this from a truth does not follow it").req().positive(),
