@@ -59,8 +59,9 @@ class GatedPairs {
     widths_.clear();
     for (auto& w : axis_widths_) w.clear();
     const bool cartesian = scan.sensor.frame == Frame::Cartesian;
-    // Measurement frames whose values are [range, azimuth(, elevation)(, range rate)], the azimuth
-    // wrapped by the gate.
+    // The frames whose values are [range, azimuth(, elevation)(, range rate)] with the azimuth
+    // residual wrapped by the gate (gating.hpp); a range-azimuth frame would join here. `axes`: how
+    // many leading values are binned, min(3, every track's and detection's value count).
     const bool spherical = scan.sensor.frame == Frame::Spherical;
     int axes = 3;
     for (std::size_t i = 0; i < n; ++i) {
@@ -113,19 +114,22 @@ class GatedPairs {
         grid_.for_each_candidate(centre - half, centre + half, test);
         continue;
       }
-      Eigen::Vector3d centre = Eigen::Vector3d::Zero(), half = Eigen::Vector3d::Zero();
-      for (int k = 0; k < (polar_grid ? axes : 0); ++k) {
-        centre(k) = p.z(k);
-        half(k) = std::sqrt(gamma * p.S(k, k)) * (1.0 + 1e-6) + 1e-9 * (1.0 + std::fabs(p.z(k)));
+      if (polar_grid) {
+        Eigen::Vector3d centre = Eigen::Vector3d::Zero(), half = Eigen::Vector3d::Zero();
+        for (int k = 0; k < axes; ++k) {
+          centre(k) = p.z(k);
+          half(k) = std::sqrt(gamma * p.S(k, k)) * (1.0 + 1e-6) + 1e-9 * (1.0 + std::fabs(p.z(k)));
+        }
+        if (centre.allFinite() && !half.hasNaN()) {
+          const std::size_t first = pairs_.size();
+          polar_grid_.for_each_candidate(centre, half, test);
+          // The grid lists cell by cell; the all-pairs test's order is by detection.
+          std::sort(pairs_.begin() + static_cast<std::ptrdiff_t>(first), pairs_.end(),
+                    [](const GatedPair& a, const GatedPair& b) { return a.detection < b.detection; });
+          continue;
+        }
       }
-      if (polar_grid && centre.allFinite() && !half.hasNaN()) {
-        const std::size_t first = pairs_.size();
-        polar_grid_.for_each_candidate(centre, half, test);
-        std::sort(pairs_.begin() + static_cast<std::ptrdiff_t>(first), pairs_.end(),
-                  [](const GatedPair& a, const GatedPair& b) { return a.detection < b.detection; });
-      } else {
-        for (std::size_t j = 0; j < m; ++j) test(static_cast<int>(j));
-      }
+      for (std::size_t j = 0; j < m; ++j) test(static_cast<int>(j));
     }
     return pairs_;
   }
