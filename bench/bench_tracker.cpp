@@ -1,6 +1,7 @@
 // Purpose: benchmark: tracker.multi (assoc.gnn + init.m_of_n + delete.misses, a CV filter.kalman per track; filter.ekf on spherical plots) scans per second on Stone Soup's k-d-tree tutorial scenario, a 1000-target case in Cartesian and in spherical scans, heap allocations per scan, and sink.gospa steps per second.
 //
 // Usage: trackflow-bench-tracker [--runs N] [--rounds R] [--plugins DIR] [--case kdtree|scale|spherical|gospa|all]
+//                                [--targets N]
 // Single thread, CPU time of the process (and wall time). The scans of every run are made first by
 // sim.scenario (not timed) and stored; each round then feeds them to a fresh tracker.multi, run by
 // run, and counts scans per second. The tracker's published track sets go to a consumer that reads
@@ -22,7 +23,8 @@
 //           it): [range, azimuth, elevation] plots, sigmas 0.5 m and 0.3 mrad, P_D 0.9, 1000 clutter
 //           plots per scan over 0-2.2 km, all azimuths, -2 to 80 deg; a CV filter.ekf per track. The
 //           targets surround the radar, so gates cross the azimuth seam and the nearest ones have
-//           azimuth gates wider than the circle (the spherical pre-gate's edge cases).
+//           azimuth gates wider than the circle (the spherical pre-gate's edge cases). --targets N: N
+//           targets and N clutter plots at the same densities (region and reach scaled by sqrt(N/1000)).
 //   gospa   sink.gospa over 50 000 steps with 50 truths and 50 tracks each (a track 0.5 m off each
 //           truth, 10 % of them 100 m off: missed + false).
 #include "bench_common.hpp"
@@ -31,6 +33,8 @@
 #include <trackflow/tracks.hpp>
 
 #include <atomic>
+#include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <new>
 #include <vector>
@@ -286,16 +290,17 @@ void run_gospa_case(const host::PluginRegistry& reg, int rounds) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int runs = 100, rounds = 3;
+  int runs = 100, rounds = 3, spherical_targets = 1000;
   std::string plugin_dir = TRACKFLOW_BENCH_PLUGIN_DIR, which = "all";
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--plugins")) plugin_dir = argv[i + 1];
     else if (!std::strcmp(argv[i], "--runs")) runs = std::max(1, std::atoi(argv[i + 1]));
     else if (!std::strcmp(argv[i], "--rounds")) rounds = std::max(1, std::atoi(argv[i + 1]));
     else if (!std::strcmp(argv[i], "--case")) which = argv[i + 1];
+    else if (!std::strcmp(argv[i], "--targets")) spherical_targets = std::max(1, std::atoi(argv[i + 1]));
     else {
       std::fprintf(stderr, "unknown option %s; usage: trackflow-bench-tracker [--runs N] [--rounds R] [--plugins DIR] "
-                   "[--case kdtree|scale|spherical|gospa|all]\n", argv[i]);
+                   "[--case kdtree|scale|spherical|gospa|all] [--targets N (spherical)]\n", argv[i]);
       return 2;
     }
   }
@@ -317,15 +322,23 @@ int main(int argc, char** argv) {
                      "  initial_targets: 1000, birth_velocity_sigma: [1 m/s, 1 m/s, 0 m/s], process_noise_q: 0.005 m2/s3,"
                      "  detection_probability: 0.9, measurement_sigma: 0.5 m, clutter_rate: 1000 }",
                      std::max(2, runs / 10), rounds, 6);
-  if (which == "all" || which == "spherical")
-    run_tracker_case(reg, "spherical",
-                     "{ period: 5 s, duration: 145 s, planar: true, region_lo: [-1500 m, -1500 m], region_hi: [1500 m, 1500 m],"
-                     "  initial_targets: 1000, birth_velocity_sigma: [1 m/s, 1 m/s, 0 m/s], process_noise_q: 0.005 m2/s3,"
-                     "  detection_probability: 1, measurement_sigma: 0.5 m }",
-                     std::max(2, runs / 10), rounds, 6, kSphericalTracker,
-                     "{ position: [0 m, 0 m, -30 m], sigma_range: 0.5 m, sigma_azimuth: 0.3 mrad, sigma_elevation: 0.3 mrad,"
-                     "  detection_probability: 0.9, range_max: 2200 m, elevation_min: -2 deg, elevation_max: 80 deg,"
-                     "  clutter_rate: 1000 }");
+  if (which == "all" || which == "spherical") {
+    // --targets N: N targets and N clutter plots, the region's side and the radar's reach scaled by
+    // sqrt(N / 1000) so that the densities stay those of 1000 (how the cost grows with the scene).
+    const double k = std::sqrt(spherical_targets / 1000.0);
+    char scenario[512], radar[512];
+    std::snprintf(scenario, sizeof scenario,
+                  "{ period: 5 s, duration: 145 s, planar: true, region_lo: [-%.9g m, -%.9g m], region_hi: [%.9g m, %.9g m],"
+                  "  initial_targets: %d, birth_velocity_sigma: [1 m/s, 1 m/s, 0 m/s], process_noise_q: 0.005 m2/s3,"
+                  "  detection_probability: 1, measurement_sigma: 0.5 m }",
+                  1500 * k, 1500 * k, 1500 * k, 1500 * k, spherical_targets);
+    std::snprintf(radar, sizeof radar,
+                  "{ position: [0 m, 0 m, -30 m], sigma_range: 0.5 m, sigma_azimuth: 0.3 mrad, sigma_elevation: 0.3 mrad,"
+                  "  detection_probability: 0.9, range_max: %.9g m, elevation_min: -2 deg, elevation_max: 80 deg,"
+                  "  clutter_rate: %d }",
+                  2200 * k, spherical_targets);
+    run_tracker_case(reg, "spherical", scenario, std::max(2, runs / 10), rounds, 6, kSphericalTracker, radar);
+  }
   if (which == "all" || which == "gospa") run_gospa_case(reg, rounds);
   return 0;
 }
