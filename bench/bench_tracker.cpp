@@ -1,6 +1,7 @@
-// Purpose: benchmark: tracker.multi (assoc.gnn + init.m_of_n + delete.misses, a CV filter.kalman per track) scans per second on Stone Soup's k-d-tree tutorial scenario and a 1000-target case, heap allocations per scan, and sink.gospa steps per second.
+// Purpose: benchmark: tracker.multi (assoc.gnn + init.m_of_n + delete.misses, a CV filter.kalman per track; filter.ekf on spherical plots) scans per second on Stone Soup's k-d-tree tutorial scenario, a 1000-target case in Cartesian and in spherical scans, heap allocations per scan, and sink.gospa steps per second.
 //
-// Usage: trackflow-bench-tracker [--runs N] [--rounds R] [--plugins DIR] [--case kdtree|scale|gospa|all]
+// Usage: trackflow-bench-tracker [--runs N] [--rounds R] [--plugins DIR] [--case kdtree|scale|spherical|gospa|all]
+//                                [--targets N]
 // Single thread, CPU time of the process (and wall time). The scans of every run are made first by
 // sim.scenario (not timed) and stored; each round then feeds them to a fresh tracker.multi, run by
 // run, and counts scans per second. The tracker's published track sets go to a consumer that reads
@@ -18,6 +19,12 @@
 //           R = 0.25 I m2, scans every 5 s, 30 scans a run (about 55 targets alive on average, ~100
 //           detections per scan; docs/performance.md gives the peer's figures on this machine).
 //   scale   1000 targets that live throughout and 1000 clutter detections per scan over 3 km x 3 km.
+//   spherical  the scale case's targets seen by sim.scan_radar at the centre of the region (30 m below
+//           it): [range, azimuth, elevation] plots, sigmas 0.5 m and 0.3 mrad, P_D 0.9, 1000 clutter
+//           plots per scan over 0-2.2 km, all azimuths, -2 to 80 deg; a CV filter.ekf per track. The
+//           targets surround the radar, so gates cross the azimuth seam and the nearest ones have
+//           azimuth gates wider than the circle (the spherical pre-gate's edge cases). --targets N: N
+//           targets and N clutter plots at the same densities (region and reach scaled by sqrt(N/1000)).
 //   gospa   sink.gospa over 50 000 steps with 50 truths and 50 tracks each (a track 0.5 m off each
 //           truth, 10 % of them 100 m off: missed + false).
 #include "bench_common.hpp"
@@ -26,6 +33,8 @@
 #include <trackflow/tracks.hpp>
 
 #include <atomic>
+#include <cmath>
+#include <cstdio>
 #include <cstring>
 #include <new>
 #include <vector>
@@ -93,16 +102,28 @@ struct TrackConsumer final : Component {
   }
 };
 
+// `radar_yaml` empty: sim.scenario's own (Cartesian) scans; else its truths go through a
+// sim.scan_radar of these parameters and its scans are the ones stored.
 std::vector<std::vector<StoredScan>> make_scans(const host::PluginRegistry& reg, const std::string& scenario_yaml,
-                                                int runs, double* mean_detections, double* mean_alive) {
+                                                const std::string& radar_yaml, int runs, double* mean_detections,
+                                                double* mean_alive) {
   std::vector<std::vector<StoredScan>> all(static_cast<std::size_t>(runs));
   auto gen_c = make(reg, "sim.scenario", scenario_yaml);
   auto* gen = dynamic_cast<Generator*>(gen_c.get());
+  std::shared_ptr<Component> radar = radar_yaml.empty() ? nullptr : make(reg, "sim.scan_radar", radar_yaml);
   Recorder rec;
   std::vector<Truth> truths;
   rec.truths = &truths;
-  const Link links[1] = {{&rec, 0, 0xFF}};
-  gen->out.connect(links, 1);
+  // Outputs keep a pointer to their links: these live as long as the runs.
+  const Link direct[1] = {{&rec, 0, 0xFF}};
+  const Link via_radar[2] = {{radar.get(), 0, mask(ItemKind::Truth)}, {&rec, 0, mask(ItemKind::Truth)}};
+  const Link radar_links[1] = {{&rec, 0, mask(ItemKind::Scan)}};
+  if (radar) {
+    gen->out.connect(via_radar, 2);
+    radar->out.connect(radar_links, 1);
+  } else {
+    gen->out.connect(direct, 1);
+  }
   double detections = 0, scans = 0;
   for (int r = 0; r < runs; ++r) {
     rec.scans = &all[static_cast<std::size_t>(r)];
@@ -110,8 +131,19 @@ std::vector<std::vector<StoredScan>> make_scans(const host::PluginRegistry& reg,
     ctx.run = static_cast<std::uint64_t>(r);
     ctx.seed = 0x9e3779b97f4a7c15ull * static_cast<std::uint64_t>(r + 1);
     gen->start_run(ctx);
-    while (std::isfinite(gen->next_time())) gen->emit_next();
+    if (radar) {
+      RunContext radar_ctx = ctx;
+      radar_ctx.seed ^= 0x5851f42d4c957f2dull;  // its own random stream
+      radar->start_run(radar_ctx);
+    }
+    while (std::isfinite(gen->next_time())) {
+      const double t = gen->next_time();
+      gen->emit_next();
+      // The instant is complete when the source's next item is later (what the engine does).
+      if (radar && gen->next_time() != t) radar->on_time_complete(t);
+    }
     gen->end_run();
+    if (radar) radar->end_run();
     for (const StoredScan& s : all[static_cast<std::size_t>(r)]) {
       detections += static_cast<double>(s.detections.size());
       scans += 1;
@@ -188,11 +220,18 @@ const char* kTracker =
     "  initiator: { type: init.m_of_n, m: 3, n: 4, max_speed: 10 m/s },"
     "  deleter: { type: delete.misses, max_misses: 3 } }";
 
+// The same tracker on spherical plots: the EKF linearises the [range, azimuth, elevation] measurement.
+const char* kSphericalTracker =
+    "{ estimator: { type: filter.ekf, motion: constant_velocity, q: 0.005 m2/s3 },"
+    "  associator: { type: assoc.gnn, gate_probability: 0.99 },"
+    "  initiator: { type: init.m_of_n, m: 3, n: 4, max_speed: 10 m/s },"
+    "  deleter: { type: delete.misses, max_misses: 3 } }";
+
 void run_tracker_case(const host::PluginRegistry& reg, const char* name, const std::string& scenario, int runs,
-                      int rounds, int warm_up) {
+                      int rounds, int warm_up, const char* tracker = kTracker, const std::string& radar = "") {
   double dets = 0, alive = 0;
-  const auto scans = make_scans(reg, scenario, runs, &dets, &alive);
-  const TrackerResult r = bench_tracker(reg, kTracker, scans, rounds, warm_up);
+  const auto scans = make_scans(reg, scenario, radar, runs, &dets, &alive);
+  const TrackerResult r = bench_tracker(reg, tracker, scans, rounds, warm_up);
   std::printf("%-8s %4d runs x %3zu scans, %6.1f targets alive, %7.1f detections/scan, %6.1f confirmed tracks/scan\n", name,
               runs, scans.front().size(), alive, dets, r.confirmed_per_scan);
   std::printf("         %12.0f scans/CPU-s %12.0f scans/wall-s %10.1f us/scan (CPU)\n", r.rate.cpu, r.rate.wall,
@@ -251,22 +290,24 @@ void run_gospa_case(const host::PluginRegistry& reg, int rounds) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  int runs = 100, rounds = 3;
+  int runs = 100, rounds = 3, spherical_targets = 1000;
   std::string plugin_dir = TRACKFLOW_BENCH_PLUGIN_DIR, which = "all";
   for (int i = 1; i + 1 < argc; i += 2) {
     if (!std::strcmp(argv[i], "--plugins")) plugin_dir = argv[i + 1];
     else if (!std::strcmp(argv[i], "--runs")) runs = std::max(1, std::atoi(argv[i + 1]));
     else if (!std::strcmp(argv[i], "--rounds")) rounds = std::max(1, std::atoi(argv[i + 1]));
     else if (!std::strcmp(argv[i], "--case")) which = argv[i + 1];
+    else if (!std::strcmp(argv[i], "--targets")) spherical_targets = std::max(1, std::atoi(argv[i + 1]));
     else {
       std::fprintf(stderr, "unknown option %s; usage: trackflow-bench-tracker [--runs N] [--rounds R] [--plugins DIR] "
-                   "[--case kdtree|scale|gospa|all]\n", argv[i]);
+                   "[--case kdtree|scale|spherical|gospa|all] [--targets N (spherical)]\n", argv[i]);
       return 2;
     }
   }
   host::PluginRegistry reg;
   reg.load_directories({plugin_dir});
-  std::printf("tracker.multi (filter.kalman CV + assoc.gnn + init.m_of_n + delete.misses), 1 thread, best of %d rounds\n",
+  std::printf("tracker.multi (filter.kalman CV, spherical: filter.ekf CV + assoc.gnn + init.m_of_n + delete.misses), 1 thread, "
+              "best of %d rounds\n",
               rounds);
   if (which == "all" || which == "kdtree")
     run_tracker_case(reg, "kdtree",
@@ -281,6 +322,23 @@ int main(int argc, char** argv) {
                      "  initial_targets: 1000, birth_velocity_sigma: [1 m/s, 1 m/s, 0 m/s], process_noise_q: 0.005 m2/s3,"
                      "  detection_probability: 0.9, measurement_sigma: 0.5 m, clutter_rate: 1000 }",
                      std::max(2, runs / 10), rounds, 6);
+  if (which == "all" || which == "spherical") {
+    // --targets N: N targets and N clutter plots, the region's side and the radar's reach scaled by
+    // sqrt(N / 1000) so that the densities stay those of 1000 (how the cost grows with the scene).
+    const double k = std::sqrt(spherical_targets / 1000.0);
+    char scenario[512], radar[512];
+    std::snprintf(scenario, sizeof scenario,
+                  "{ period: 5 s, duration: 145 s, planar: true, region_lo: [-%.9g m, -%.9g m], region_hi: [%.9g m, %.9g m],"
+                  "  initial_targets: %d, birth_velocity_sigma: [1 m/s, 1 m/s, 0 m/s], process_noise_q: 0.005 m2/s3,"
+                  "  detection_probability: 1, measurement_sigma: 0.5 m }",
+                  1500 * k, 1500 * k, 1500 * k, 1500 * k, spherical_targets);
+    std::snprintf(radar, sizeof radar,
+                  "{ position: [0 m, 0 m, -30 m], sigma_range: 0.5 m, sigma_azimuth: 0.3 mrad, sigma_elevation: 0.3 mrad,"
+                  "  detection_probability: 0.9, range_max: %.9g m, elevation_min: -2 deg, elevation_max: 80 deg,"
+                  "  clutter_rate: %d }",
+                  2200 * k, spherical_targets);
+    run_tracker_case(reg, "spherical", scenario, std::max(2, runs / 10), rounds, 6, kSphericalTracker, radar);
+  }
   if (which == "all" || which == "gospa") run_gospa_case(reg, rounds);
   return 0;
 }
