@@ -1,6 +1,6 @@
 // Purpose: benchmark: tracker.multi (assoc.gnn + init.m_of_n + delete.misses, a CV filter.kalman per track) scans per second on Stone Soup's k-d-tree tutorial scenario and a 1000-target case, heap allocations per scan, and sink.gospa steps per second.
 //
-// Usage: trackflow-bench-tracker [--runs N] [--rounds R] [--plugins DIR] [--case kdtree|scale|gospa|all]
+// Usage: trackflow-bench-tracker [--runs N] [--rounds R] [--plugins DIR] [--case kdtree|adapted|scale|gospa|all]
 // Single thread, CPU time of the process (and wall time). The scans of every run are made first by
 // sim.scenario (not timed) and stored; each round then feeds them to a fresh tracker.multi, run by
 // run, and counts scans per second. The tracker's published track sets go to a consumer that reads
@@ -17,6 +17,7 @@
 //           probability 0.05 per step, 50 clutter detections per scan over 1 km x 1 km, P_D 0.9,
 //           R = 0.25 I m2, scans every 5 s, 30 scans a run (about 55 targets alive on average, ~100
 //           detections per scan; docs/performance.md gives the peer's figures on this machine).
+//   adapted the kdtree case with adapt.innovation_r on every track (tracker.multi `adapters:`).
 //   scale   1000 targets that live throughout and 1000 clutter detections per scan over 3 km x 3 km.
 //   gospa   sink.gospa over 50 000 steps with 50 truths and 50 tracks each (a track 0.5 m off each
 //           truth, 10 % of them 100 m off: missed + false).
@@ -188,11 +189,20 @@ const char* kTracker =
     "  initiator: { type: init.m_of_n, m: 3, n: 4, max_speed: 10 m/s },"
     "  deleter: { type: delete.misses, max_misses: 3 } }";
 
+// The same tracker with adapt.innovation_r on every track (tracker.multi `adapters:`): each track
+// slot keeps its own adapter instance, so the claim of no allocation per scan holds with it too.
+const char* kAdaptedTracker =
+    "{ estimator: { type: filter.kalman, motion: constant_velocity, q: 0.005 m2/s3 },"
+    "  adapters: [ { type: adapt.innovation_r, window: 20, warmup: 5 } ],"
+    "  associator: { type: assoc.gnn, gate_probability: 0.99 },"
+    "  initiator: { type: init.m_of_n, m: 3, n: 4, max_speed: 10 m/s },"
+    "  deleter: { type: delete.misses, max_misses: 3 } }";
+
 void run_tracker_case(const host::PluginRegistry& reg, const char* name, const std::string& scenario, int runs,
-                      int rounds, int warm_up) {
+                      int rounds, int warm_up, const char* tracker_yaml = kTracker) {
   double dets = 0, alive = 0;
   const auto scans = make_scans(reg, scenario, runs, &dets, &alive);
-  const TrackerResult r = bench_tracker(reg, kTracker, scans, rounds, warm_up);
+  const TrackerResult r = bench_tracker(reg, tracker_yaml, scans, rounds, warm_up);
   std::printf("%-8s %4d runs x %3zu scans, %6.1f targets alive, %7.1f detections/scan, %6.1f confirmed tracks/scan\n", name,
               runs, scans.front().size(), alive, dets, r.confirmed_per_scan);
   std::printf("         %12.0f scans/CPU-s %12.0f scans/wall-s %10.1f us/scan (CPU)\n", r.rate.cpu, r.rate.wall,
@@ -260,7 +270,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--case")) which = argv[i + 1];
     else {
       std::fprintf(stderr, "unknown option %s; usage: trackflow-bench-tracker [--runs N] [--rounds R] [--plugins DIR] "
-                   "[--case kdtree|scale|gospa|all]\n", argv[i]);
+                   "[--case kdtree|adapted|scale|gospa|all]\n", argv[i]);
       return 2;
     }
   }
@@ -268,13 +278,15 @@ int main(int argc, char** argv) {
   reg.load_directories({plugin_dir});
   std::printf("tracker.multi (filter.kalman CV + assoc.gnn + init.m_of_n + delete.misses), 1 thread, best of %d rounds\n",
               rounds);
-  if (which == "all" || which == "kdtree")
-    run_tracker_case(reg, "kdtree",
-                     "{ period: 5 s, duration: 145 s, planar: true, region_lo: [-500 m, -500 m], region_hi: [500 m, 500 m],"
-                     "  initial_targets: 100, birth_rate: 0.3, survival_probability: 0.95,"
-                     "  birth_velocity_sigma: [1 m/s, 1 m/s, 0 m/s], process_noise_q: 0.005 m2/s3,"
-                     "  detection_probability: 0.9, measurement_sigma: 0.5 m, clutter_rate: 50 }",
-                     runs, rounds, 4);
+  const char* kdtree_scenario =
+      "{ period: 5 s, duration: 145 s, planar: true, region_lo: [-500 m, -500 m], region_hi: [500 m, 500 m],"
+      "  initial_targets: 100, birth_rate: 0.3, survival_probability: 0.95,"
+      "  birth_velocity_sigma: [1 m/s, 1 m/s, 0 m/s], process_noise_q: 0.005 m2/s3,"
+      "  detection_probability: 0.9, measurement_sigma: 0.5 m, clutter_rate: 50 }";
+  if (which == "all" || which == "kdtree") run_tracker_case(reg, "kdtree", kdtree_scenario, runs, rounds, 4);
+  // The kdtree case with per-track adapt.innovation_r (tracker.multi `adapters:`).
+  if (which == "all" || which == "adapted")
+    run_tracker_case(reg, "adapted", kdtree_scenario, runs, rounds, 4, kAdaptedTracker);
   if (which == "all" || which == "scale")
     run_tracker_case(reg, "scale",
                      "{ period: 5 s, duration: 145 s, planar: true, region_lo: [-1500 m, -1500 m], region_hi: [1500 m, 1500 m],"
