@@ -4,6 +4,7 @@
 #include <trackflow/host/guard.hpp>
 #include <trackflow/host/suggest.hpp>
 #include <trackflow/host/validate.hpp>
+#include <trackflow/track_adapters.hpp>
 
 #include <algorithm>
 #include <functional>
@@ -353,6 +354,18 @@ GraphInstance instantiate_checked(const Graph& g, const PluginRegistry& registry
                             " annotations; at most " + std::to_string(kMaxAnnotations) + " fit on an estimate",
                         g.nodes[i].config.loc, g.nodes[i].config.id);
     for (size_t k = 0; k < names.size(); ++k) annotations[i].push_back(qualified(g.nodes[i].config.id, names, k));
+  }
+  // A node that runs adapters itself (a component-list parameter of kind adapter: tracker.multi's
+  // per-track `adapters:`, track_adapters.hpp) carries their values on its estimates, named
+  // "<node id>.<adapter type>.<name>"; it checks the adapters itself when it is made.
+  for (size_t i = 0; i < N; ++i) {
+    if (dynamic_cast<Filter*>(inst.components[i].get())) continue;
+    for (const ParamSpec& spec : g.nodes[i].type->decl.params) {
+      if (spec.type != ParamType::ComponentList || spec.kinds != std::vector<ComponentKind>{ComponentKind::Adapter})
+        continue;
+      for (const std::string& name : TrackAdapters::annotation_names_of(g.nodes[i].params.components(spec.name)))
+        annotations[i].push_back(g.nodes[i].config.id + "." + name);
+    }
   }
   for (size_t i = 0; i < N; ++i) {
     const GraphNode& n = g.nodes[i];

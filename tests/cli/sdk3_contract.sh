@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Purpose: the typed filter–adapter contract and frame-typed ports: wrong wires and wrong attachments refused at validate time with file:line:col; invalid log rows coast every convert.* -> filter combination; adapted noise restored by the engine at every run.
+# Purpose: the typed filter–adapter contract and frame-typed ports: wrong wires and wrong attachments refused at validate time with file:line:col; invalid log rows coast every convert.* -> filter combination; adapted noise restored by the engine at every run, and by tracker.multi at every track (per-track adapters).
 set -u
 TF=$1
 PLUGINS=$2
@@ -124,6 +124,50 @@ firsts=$(awk -F, 'NR > 1 && !seen[$1]++ { print $NF }' "$TMP/t1/rows.csv" | sort
 runs=$(awk -F, 'NR > 1 { print $1 }' "$TMP/t1/rows.csv" | sort -u | wc -l)
 [ "$runs" -eq 4 ] || fail "expected 4 runs in rows.csv, found $runs"
 checks=$((checks + 1)); echo "ok: every run starts from the configured q, identical for 1 and 2 threads"
+
+# 4b. Per track in tracker.multi (adapters:): every track, in a fresh slot or one a deleted track
+# (clutter tracks fail M-of-N all the time) or an earlier run left, starts from the configured q.
+# test.q_ramp runs before each of the track's two initiating detections, so its first published
+# estimate carries the q seen at the second: 2 x the configured 2 = 4, for every track.
+cat > "$TMP/ramp_tracks.yaml" <<'YAML'
+pipeline: { name: ramp_tracks, seed: 2, runs: 3 }
+nodes:
+  - id: scenario
+    type: sim.scenario
+    params:
+      duration: 15 s
+      planar: true
+      region_lo: [-1 km, -1 km]
+      region_hi: [1 km, 1 km]
+      targets:
+        - { initial_position: [-400 m, 0 m, 0 m], initial_velocity: [10 m/s, 0 m/s, 0 m/s] }
+        - { initial_position: [400 m, 100 m, 0 m], initial_velocity: [-10 m/s, 0 m/s, 0 m/s] }
+      measurement_sigma: 5 m
+      clutter_rate: 20
+  - id: mtt
+    type: tracker.multi
+    input: scenario
+    params:
+      estimator: { type: filter.kalman, q: 2 m2/s3 }
+      adapters: [ { type: test.q_ramp } ]
+      associator: { type: assoc.gnn }
+      initiator: { type: init.m_of_n, max_speed: 200 m/s }
+      deleter: { type: delete.misses }
+  - id: rows
+    type: sink.csv
+    inputs: [mtt]
+    params: { precision: 17 }
+YAML
+expect_run "q_ramp per track runs (1 thread)" 0 "rows" -- "$TF" run "$TMP/ramp_tracks.yaml" --plugin-path "$TEST_PLUGINS" --threads 1 --no-progress --out "$TMP/rt1"
+expect_run "q_ramp per track runs (2 threads)" 0 "rows" -- "$TF" run "$TMP/ramp_tracks.yaml" --plugin-path "$TEST_PLUGINS" --threads 2 --no-progress --out "$TMP/rt2"
+head -n 1 "$TMP/rt1/rows.csv" | grep -q ',mtt.test.q_ramp.q_seen$' || fail "sink.csv has no mtt.test.q_ramp.q_seen column: $(head -n 1 "$TMP/rt1/rows.csv")"
+cmp -s "$TMP/rt1/rows.csv" "$TMP/rt2/rows.csv" || fail "q_ramp per track: output differs between --threads 1 and 2"
+# The first row of each (run, track id): the q its adapter saw at the track's second detection.
+firsts=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) if ($i == "track_id") id = i } NR > 1 && !seen[$1 "/" $id]++ { print $NF }' "$TMP/rt1/rows.csv" | sort -u)
+[ "$firsts" = "4" ] || fail "q seen at the first estimate of the tracks: '$firsts', expected only 4 (2 x the configured 2)"
+tracks=$(awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) if ($i == "track_id") id = i } NR > 1 { print $1 "/" $id }' "$TMP/rt1/rows.csv" | sort -u | wc -l)
+[ "$tracks" -gt 20 ] || fail "expected clutter tracks to come and go (slots reused), found only $tracks tracks"
+checks=$((checks + 1)); echo "ok: every track of tracker.multi starts from the configured q ($tracks tracks), identical for 1 and 2 threads"
 
 
 # 5. What set_inputs learns (InputInfo, SDK 0.5): an upstream filter's state layout by name and

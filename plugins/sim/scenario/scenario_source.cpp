@@ -39,6 +39,9 @@ struct Box {
 struct ScriptedTarget {
   Vec3 position, velocity;  // at birth_time
   double birth = 0.0, death = kInf;
+  // Its detections' true noise is noise_factor σ, while their covariance states σ (a target the
+  // sensor measures worse than it reports: glint, a tumbling body); 1: as stated.
+  double noise_factor = 1.0;
 };
 
 struct Target {
@@ -121,6 +124,7 @@ Settings read_settings(const Params& p) {
     t.velocity = r.vec3("initial_velocity");
     t.birth = r.real("birth_time");
     t.death = r.has("death_time") ? r.real("death_time") : kInf;
+    t.noise_factor = r.real("noise_factor");
     if (!(t.death > t.birth))
       throw r.error("death_time", "must be after birth_time (" + std::to_string(t.birth) + " s)");
     if (s.planar && (t.position.z() != 0.0 || t.velocity.z() != 0.0))
@@ -338,24 +342,26 @@ class ScenarioSource final : public Generator, public FieldListCodec<ScenarioRun
 
   void sense(double t) {
     detections_.clear();
-    const int k = s_.measured;
+    const int k_values = s_.measured;  // position values per detection: 3, or 2 (planar x, y)
     Detection d;
-    d.value.resize(k);
-    d.covariance.setZero(k, k);
-    for (int i = 0; i < k; ++i) d.covariance(i, i) = s_.sigma[i] * s_.sigma[i];
+    d.value.resize(k_values);
+    d.covariance.setZero(k_values, k_values);
+    for (int i = 0; i < k_values; ++i) d.covariance(i, i) = s_.sigma[i] * s_.sigma[i];
     for (const Target& x : living_) {
       if (!(rng_.uniform() < s_.pd)) {
         ++run_.missed;
         continue;
       }
-      for (int i = 0; i < k; ++i) d.value[i] = x.position[i] + s_.sigma[i] * rng_.normal();
+      // k = 1 (every random-born target, a scripted one by default): k σ is σ exactly.
+      const double k = x.scripted ? s_.scripted[x.script].noise_factor : 1.0;
+      for (int i = 0; i < k_values; ++i) d.value[i] = x.position[i] + k * s_.sigma[i] * rng_.normal();
       d.origin = x.id;
       detections_.push_back(d);
       ++run_.detections;
     }
     d.origin = kOriginClutter;
     for (std::uint64_t n = poisson(rng_, s_.clutter_mean); n > 0; --n) {
-      for (int i = 0; i < k; ++i) d.value[i] = s_.region.lo[i] + (s_.region.hi[i] - s_.region.lo[i]) * rng_.uniform();
+      for (int i = 0; i < k_values; ++i) d.value[i] = s_.region.lo[i] + (s_.region.hi[i] - s_.region.lo[i]) * rng_.uniform();
       detections_.push_back(d);
       ++run_.clutter;
     }
@@ -386,6 +392,11 @@ std::vector<ParamSpec> target_fields() {
       ParamSpec::real_list("initial_velocity", dim::velocity, "ENU velocity [vx, vy, vz]", 3).def("[0, 0, 0]"),
       ParamSpec::real("birth_time", dim::time, "first time it exists (from the first step at or after it)").def("0 s"),
       ParamSpec::real("death_time", dim::time, "time it stops existing: its last step is the one before (default: never)"),
+      ParamSpec::real("noise_factor", dim::none,
+                      "its detections' true noise is noise_factor x the stated sigma (their covariance still states "
+                      "sigma): a target measured worse than the sensor reports")
+          .def("1")
+          .positive(),
   };
 }
 
@@ -410,8 +421,9 @@ void register_components(Registrar& r) {
       "n+1, ... in birth order; ids are never reused in a run. The node then emits one Truth per living target in "
       "id order (its acceleration: the mean white acceleration of the step, zero without noise), then one Scan of "
       "the same time: each living target is detected with probability detection_probability, value = position + "
-      "N(0, diag(σ², σ², σ_z²)) (σ = measurement_sigma, σ_z = measurement_sigma_z, default σ), covariance the same "
-      "diagonal, origin = its id; plus a Poisson number of clutter detections of mean clutter_rate (or "
+      "N(0, k² diag(σ², σ², σ_z²)) (σ = measurement_sigma, σ_z = measurement_sigma_z, default σ; k = the scripted "
+      "target's noise_factor, default 1, 1 for random-born ones), covariance diag(σ², σ², σ_z²) whatever k, origin "
+      "= its id; plus a Poisson number of clutter detections of mean clutter_rate (or "
       "clutter_density × region volume), uniform over the surveillance region [region_lo, region_hi], origin "
       "clutter. Detections are sorted by x, then y, then z. The Scan is Cartesian (value = ENU position), its sensor "
       "at sensor_position, its region the surveillance box (known, dim 3), its clutter_density the expected clutter "

@@ -1,4 +1,4 @@
-// Purpose: tests of sim.scenario: item order, ids, detection probability, clutter, births and survival, determinism, parameter refusals.
+// Purpose: tests of sim.scenario: item order, ids, detection probability, a scripted target's noise_factor, clutter, births and survival, determinism, parameter refusals.
 #include <catch2/catch.hpp>
 
 #include "plugin_fixture.hpp"
@@ -141,6 +141,41 @@ TEST_CASE("P_D 1 detects every target once") {
     CHECK(e.clutter_density == 0.0);
     truth.clear();
   }
+}
+
+// noise_factor 3 on target 1: its detections scatter with 3 sigma while their covariance still
+// states sigma; target 0 (default 1) keeps sigma. Sample RMS per axis over 2 x 201 x 3 draws each.
+TEST_CASE("noise_factor scales a target's true noise only") {
+  const auto ev = simulate(R"(
+  period: 1 s
+  duration: 200 s
+  region_lo: [-1000 m, -1000 m, -100 m]
+  region_hi: [1000 m, 1000 m, 100 m]
+  measurement_sigma: 2 m
+  targets:
+    - {initial_position: [-500, 0, 0], initial_velocity: [1, 0, 0]}
+    - {initial_position: [0, -500, 0], initial_velocity: [0, 1, 0], noise_factor: 3}
+)");
+  std::map<std::uint32_t, Vec3> truth;
+  double sum2[2] = {0, 0};
+  int n[2] = {0, 0};
+  for (const Event& e : ev) {
+    if (!e.scan) {
+      truth[e.target] = e.position;
+      continue;
+    }
+    for (const Detection& d : e.detections) {
+      REQUIRE(d.origin < 2);
+      CHECK(d.covariance(0, 0) == 4.0);  // stated sigma 2 m whatever the factor
+      sum2[d.origin] += (d.value.head<3>() - truth[d.origin]).squaredNorm();
+      n[d.origin] += 3;
+    }
+  }
+  REQUIRE(n[0] == 603);
+  REQUIRE(n[1] == 603);
+  // The RMS of 603 normal draws is within about 3 % (1 sigma) of the true sigma: 15 % bands.
+  CHECK(std::sqrt(sum2[0] / n[0]) == Approx(2.0).epsilon(0.15));
+  CHECK(std::sqrt(sum2[1] / n[1]) == Approx(6.0).epsilon(0.15));
 }
 
 // P_D = 0.5 over 20 targets x 201 scans: detected fraction within 4 binomial sigmas of 0.5

@@ -250,6 +250,9 @@ class CsvSink final : public Component, public RunResultCodec {
       if (!e.initialised) continue;
       PendingRow& r = pending_.emplace_back();
       fill_from(r, e, set.time, port);
+      // A tracker's per-track adapters' values (tracker.multi `adapters:`), named in InputInfo::annotations.
+      r.annotation_count = e.annotation_count;
+      for (int i = 0; i < e.annotation_count; ++i) r.annotations[i] = e.annotations[i];
       r.track = true;
       r.track_id = te.id;
       r.status = te.status;

@@ -656,6 +656,36 @@ TEST_CASE("track sets: a row per track, id, status, own target truth") {
   CHECK(rows[2][Nees].empty());
 }
 
+// A tracker's per-track adapters (tracker.multi `adapters:`): the values on each track's estimate
+// go to the columns its input names, per track; a track without values leaves them empty.
+TEST_CASE("track sets: per-track adapter annotations as columns") {
+  InputInfo tracker{"mtt", "tracker.multi", mask(ItemKind::Tracks)};
+  tracker.annotations = {"mtt.adapt.innovation_r.sigma_x", "mtt.adapt.innovation_r.sigma_y"};
+  auto c = make_csv("{}", {tracker});
+  c->start_run({0, 1, nullptr});
+  std::vector<TrackEstimate> set(2);
+  Vec6 x;
+  x << 11, 20, 0, 1, 0, 0;
+  for (int i = 0; i < 2; ++i) {
+    set[static_cast<size_t>(i)].id = static_cast<std::uint64_t>(i + 1);
+    set[static_cast<size_t>(i)].estimate = estimate(1.0, x, covariance());
+  }
+  set[0].estimate.annotation_count = 2;
+  set[0].estimate.annotations[0] = 2.5;
+  set[0].estimate.annotations[1] = 7.25;
+  c->on_tracks(TrackSet{1.0, set}, 0);
+  const auto rows = finished_rows(*c, scratch("track_annotations"));
+  REQUIRE(rows.size() == 3);
+  const std::vector<std::string>& head = rows[0];
+  REQUIRE(head.size() >= 2);
+  CHECK(head[head.size() - 2] == "mtt.adapt.innovation_r.sigma_x");
+  CHECK(head.back() == "mtt.adapt.innovation_r.sigma_y");
+  CHECK(num(rows[1][head.size() - 2]) == 2.5);
+  CHECK(num(rows[1].back()) == 7.25);
+  CHECK(rows[2][head.size() - 2].empty());
+  CHECK(rows[2].back().empty());
+}
+
 // A scan: one row per detection, kind detection, its position, its origin column, and the truth of
 // its origin target only (clutter has none).
 TEST_CASE("scans: a row per detection with origin and target truth") {

@@ -1,4 +1,4 @@
-// Purpose: tracker.multi — a multi-target tracker composed of parts: per scan it predicts every track, lets the associator give detections to tracks, updates, confirms and deletes (initiator, deleter), starts tracks from what no track took (initiator), and publishes one TrackSet.
+// Purpose: tracker.multi — a multi-target tracker composed of parts: per scan it predicts every track, lets the associator give detections to tracks, updates (each track's own adapters around its updates), confirms and deletes (initiator, deleter), starts tracks from what no track took (initiator), and publishes one TrackSet.
 #include "association/gating.hpp"
 #include "memory/grow.hpp"
 
@@ -8,6 +8,7 @@
 #include <trackflow/estimator.hpp>
 #include <trackflow/plugin.hpp>
 #include <trackflow/run_result_codec.hpp>
+#include <trackflow/track_adapters.hpp>
 #include <trackflow/tracker.hpp>
 
 #include <algorithm>
@@ -26,17 +27,21 @@ namespace {
 struct TrackerRunResult final : RunResult {
   std::uint64_t scans = 0, scans_not_looked = 0, scans_skipped = 0, detections = 0, updates = 0,
                 updates_refused = 0, started = 0, start_failed = 0, confirmed = 0, deleted = 0, deleted_non_finite = 0,
-                track_limit_refused = 0, confirmed_track_scans = 0;
+                track_limit_refused = 0, confirmed_track_scans = 0, deleted_by_adapter = 0;
   template <class Self, class F>
   static void fields(Self& r, F&& f) {
     f(r.scans, r.scans_not_looked, r.scans_skipped, r.detections, r.updates, r.updates_refused, r.started,
-      r.start_failed, r.confirmed, r.deleted, r.deleted_non_finite, r.track_limit_refused, r.confirmed_track_scans);
+      r.start_failed, r.confirmed, r.deleted, r.deleted_non_finite, r.track_limit_refused, r.confirmed_track_scans,
+      r.deleted_by_adapter);
   }
 };
 
-// One track: its estimator (a clone of the configured one), what it publishes, and its history.
+// One track: its estimator (a clone of the configured one), its own adapters over that estimator
+// (none when the tracker has no `adapters:`), what it publishes, and its history. Both live on the
+// heap, so they stay put when the slot moves; a reused slot reuses them.
 struct Track final : TrackContext {
   std::unique_ptr<Estimator> estimator;
+  std::unique_ptr<TrackAdapters> adapters;
   TrackEstimate published;
   PredictedMeasurement predicted;
   bool can_predict = false;
@@ -82,16 +87,26 @@ bool finite(const Estimate& e) {
 
 class MultiTracker final : public Component, public FieldListCodec<TrackerRunResult> {
  public:
-  MultiTracker(std::string node, std::unique_ptr<Estimator> prototype, std::unique_ptr<Associator> associator,
-               std::unique_ptr<Initiator> initiator, std::unique_ptr<Deleter> deleter, int max_tracks)
+  MultiTracker(std::string node, std::unique_ptr<Estimator> prototype, std::vector<NestedComponent> adapters,
+               std::unique_ptr<Associator> associator, std::unique_ptr<Initiator> initiator,
+               std::unique_ptr<Deleter> deleter, int max_tracks, std::string estimator_type)
       : node_(std::move(node)),
         prototype_(std::move(prototype)),
+        adapters_(std::move(adapters)),
         associator_(std::move(associator)),
         initiator_(std::move(initiator)),
         deleter_(std::move(deleter)),
-        max_tracks_(max_tracks) {}
+        max_tracks_(max_tracks),
+        adapters_who_("tracker.multi (node '" + node_ + "', estimator " + estimator_type + ")") {
+    // Refused now, at the offending entry's line, rather than at the first track: the adapters'
+    // needs against the estimator's noise (each track's is a clone of the prototype's).
+    if (!adapters_.empty()) {
+      const TrackAdapters check(adapters_, *prototype_, adapters_who_);
+    }
+  }
 
   void start_run(const RunContext& ctx) override {
+    ctx_ = ctx;
     diag_ = ctx.diagnostics;
     run_ = TrackerRunResult{};
     // The last run's slots become spares: their estimators' storage serves this run's tracks.
@@ -151,6 +166,7 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
     if (total_.scans_not_looked) s.metric("scans_not_looked", static_cast<double>(total_.scans_not_looked));
     if (total_.scans_skipped) s.metric("scans_skipped", static_cast<double>(total_.scans_skipped));
     if (total_.deleted_non_finite) s.metric("deleted_non_finite", static_cast<double>(total_.deleted_non_finite));
+    if (total_.deleted_by_adapter) s.metric("deleted_by_adapter", static_cast<double>(total_.deleted_by_adapter));
     if (total_.track_limit_refused) {
       s.metric("starts_refused_at_max_tracks", static_cast<double>(total_.track_limit_refused));
       s.notes.push_back(std::to_string(total_.track_limit_refused) + " track start(s) refused: max_tracks (" +
@@ -248,8 +264,10 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
         const int dim = dimension(s.sensor, d);
         to_measurement(s, d, m_);
         set_R(*t.estimator, d, dim);
+        if (t.adapters) t.adapters->before_update(m_, dim);
         used = t.estimator->update(m_, dim);
         ++(used ? run_.updates : run_.updates_refused);
+        if (t.adapters) after_update(t, m_, s.time, true);
       }
       t.history = (t.history << 1) | (used ? 1u : 0u);
       add_score(t, s, used ? &s.detections[static_cast<size_t>(assigned_[i])] : nullptr);
@@ -285,7 +303,11 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
     for (size_t i = 0; i < tracks_.size(); ++i) {
       TrackEstimate& p = tracks_[i].published;
       const TrackView& v = views_[i];
-      if (p.status == TrackStatus::Tentative) {
+      if (tracks_[i].adapters && tracks_[i].adapters->restart_requested()) {
+        // An adapter asked to forget the track (Filter::restart_track): a tracker deletes it.
+        p.status = TrackStatus::Deleted;
+        ++run_.deleted_by_adapter;
+      } else if (p.status == TrackStatus::Tentative) {
         if (initiator_->confirmed(v)) {
           p.status = TrackStatus::Confirmed;
           ++run_.confirmed;
@@ -323,20 +345,27 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
       t.published = TrackEstimate{};
       t.predicted = PredictedMeasurement{};
       t.can_predict = false;
+      if (t.adapters) t.adapters->start_track(ctx_);
       t.time = st.first.time;
       const int dim1 = dimension(st.first, st.first);
       set_R(*t.estimator, st.first, dim1);
+      if (t.adapters) t.adapters->before_update(st.first, dim1);
       bool formed = t.estimator->initiate(st.first, dim1);
+      if (t.adapters) after_update(t, st.first, st.first.time, formed);
       if (!formed) {
         const Detection& d = s.detections[static_cast<size_t>(st.second)];
         to_measurement(s, d, m_);
         t.time = s.time;
         const int dim2 = dimension(s.sensor, d);
         set_R(*t.estimator, d, dim2);
+        if (t.adapters) t.adapters->before_update(m_, dim2);
         formed = t.estimator->initiate(m_, dim2);
+        if (t.adapters) after_update(t, m_, s.time, formed);
       }
       if (!formed) {
         ++run_.start_failed;
+        // Back to the spares, estimator and adapters kept: a failed start allocates nothing next time.
+        spare_.push_back(std::move(tracks_.back()));
         tracks_.pop_back();
         continue;
       }
@@ -356,6 +385,22 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
     }
   }
 
+  // The adapters' after_update with the track's estimate from measurement m at `time` (as a
+  // single-track node publishes it: the state once initialised, otherwise flagged uninitialised).
+  // A non-finite state is not shown to them: the track is deleted when it is published.
+  void after_update(Track& t, const Measurement& m, double time, bool initialised) {
+    Estimate& e = t.published.estimate;
+    if (initialised) {
+      t.estimator->fill(e);
+      e.time = time;
+      e.initialised = true;
+      if (!finite(e)) return;
+    } else {
+      set_uninitialised(e, time);
+    }
+    t.adapters->after_update(m, e);
+  }
+
   int alive() const {
     int n = 0;
     for (const Track& t : tracks_) n += t.published.status != TrackStatus::Deleted;
@@ -369,6 +414,7 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
       tracks_.emplace_back();
       Track& fresh = tracks_.back();
       fresh.estimator = prototype_->clone();
+      if (!adapters_.empty()) fresh.adapters = std::make_unique<TrackAdapters>(adapters_, *fresh.estimator, adapters_who_);
       fresh.who = "tracker.multi (node '" + node_ + "') track";  // once per slot: a reused one keeps it
       fresh.warnings = &warnings_;
     } else {
@@ -431,10 +477,13 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
 
   std::string node_;
   std::unique_ptr<Estimator> prototype_;
+  std::vector<NestedComponent> adapters_;  // each track's adapters, as configured
   std::unique_ptr<Associator> associator_;
   std::unique_ptr<Initiator> initiator_;
   std::unique_ptr<Deleter> deleter_;
   int max_tracks_ = 0;
+  std::string adapters_who_;
+  RunContext ctx_;  // this run's, for each new track's adapters
   Diagnostics* diag_ = nullptr;
   TrackerRunResult run_, total_;
   std::uint64_t runs_ = 0;
@@ -454,12 +503,14 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
 };
 
 std::unique_ptr<Component> create(const Params& p) {
-  std::unique_ptr<Estimator> estimator = p.component("estimator").create_estimator();
+  const NestedComponent& estimator_entry = p.component("estimator");
+  std::unique_ptr<Estimator> estimator = estimator_entry.create_estimator();
   auto associator = make_part<Associator>(p.component("associator"), "an associator");
   auto initiator = make_part<Initiator>(p.component("initiator"), "an initiator");
   auto deleter = make_part<Deleter>(p.component("deleter"), "a deleter");
-  return std::make_unique<MultiTracker>(p.node(), std::move(estimator), std::move(associator), std::move(initiator),
-                                        std::move(deleter), static_cast<int>(p.integer("max_tracks")));
+  return std::make_unique<MultiTracker>(p.node(), std::move(estimator), p.components("adapters"), std::move(associator),
+                                        std::move(initiator), std::move(deleter),
+                                        static_cast<int>(p.integer("max_tracks")), estimator_entry.type);
 }
 
 void register_components(Registrar& r) {
@@ -480,8 +531,13 @@ void register_components(Registrar& r) {
       "starts at the initiator's value (0 by default) and adds per look ln(P_D/beta_FA) + ln N(nu; 0, S) for a "
       "detection used, ln(1 - P_D) for a miss, with the scan's P_D and clutter density beta_FA (NaN when the scan "
       "states them not); init.score and delete.score read it. The estimator is any filter type with a per-track "
-      "estimator (filter.kalman, filter.ekf, filter.ukf, filter.imm, ...), with that filter's parameters. See "
-      "docs/multi-target.md.";
+      "estimator (filter.kalman, filter.ekf, filter.ukf, filter.imm, ...), with that filter's parameters. Adapters "
+      "(adapters: [{type: adapt.innovation_r, ...}]) run per track: every track has its own instances, restarted "
+      "with the configured noise when the track starts, called around each of its updates (and initiating "
+      "detections) with its detection and estimate, retuning that track's estimator's noise and covariance only; "
+      "their annotations are on the track's estimate. What they need is checked against the estimator before "
+      "anything runs. Gating and the track score use the detection's own R: an adapter sees a detection only once "
+      "the associator gave it to the track. See docs/multi-target.md.";
   d.accepts = mask(ItemKind::Scan);
   d.produces = mask(ItemKind::Tracks);
   d.params = {
@@ -492,6 +548,10 @@ void register_components(Registrar& r) {
       ParamSpec::component("initiator", {ComponentKind::Initiator}, "track initiation and confirmation, e.g. { type: init.m_of_n }")
           .req(),
       ParamSpec::component("deleter", {ComponentKind::Deleter}, "deletion of confirmed tracks, e.g. { type: delete.misses }").req(),
+      ParamSpec::component_list("adapters", {ComponentKind::Adapter},
+                                "adapters run per track, each track with its own instances (as `attach_to:` on a "
+                                "single-track filter), e.g. [{ type: adapt.innovation_r, window: 20 }]; none by default")
+          .def("[]"),
       ParamSpec::integer("max_tracks", "at most this many tracks alive; further starts are refused and counted")
           .def("10000")
           .at_least(1),

@@ -1,4 +1,4 @@
-// Purpose: tests of tracker.multi with filter.kalman, assoc.gnn / assoc.nearest, init.m_of_n and delete.misses, scans fed by hand: two targets in clutter become two confirmed tracks that keep their targets; ids are never reused; a track is deleted after its misses; a scan that was not a look changes nothing; each track's score gains the hit or miss increment per look; the run result survives the codec.
+// Purpose: tests of tracker.multi with filter.kalman, assoc.gnn / assoc.nearest, init.m_of_n and delete.misses, scans fed by hand: two targets in clutter become two confirmed tracks that keep their targets; ids are never reused; a track is deleted after its misses; a scan that was not a look changes nothing; each track's score gains the hit or miss increment per look; the run result survives the codec; per-track adapters (adapt.innovation_r) adapt each track's own R, restart with a new track, and are refused when the estimator cannot serve them.
 #include <catch2/catch.hpp>
 
 #include "plugin_fixture.hpp"
@@ -257,4 +257,139 @@ TEST_CASE("the track score: a hit or miss increment per look") {
   n->on_scan(sc.scan_at(11, 0), 0);
   REQUIRE(confirmed(out.sets.back()).size() == 2);
   for (const TrackEstimate* t : confirmed(out.sets.back())) CHECK(std::isnan(t->score));
+}
+
+namespace {
+
+// Per-track adapters: two targets 400 m apart in x, both reported with sigma 2 m (R = 4 m2 I),
+// target 1 measured with that noise, target 2 with sigma `noisy_sigma` (a sensor that claims too
+// little noise for it); target 2 unseen while `hide_second` says so.
+struct NoisyPair {
+  Rng rng{11};
+  std::vector<Detection> detections;
+  double noisy_sigma = 8.0;
+  Scan scan_at(double t, bool see_second = true, double second_sigma = -1.0) {
+    detections.clear();
+    add(Vec3(0.0, -100.0 + 10.0 * t, 0.0), 1, 2.0);
+    if (see_second) add(Vec3(400.0, 100.0 - 10.0 * t, 0.0), 2, second_sigma > 0.0 ? second_sigma : noisy_sigma);
+    Scan s;
+    s.time = t;
+    s.sensor.frame = Frame::Cartesian;
+    s.detections = detections;
+    s.detection_probability = 0.99;
+    s.clutter_density = 1e-9;
+    return s;
+  }
+  void add(const Vec3& p, std::uint32_t origin, double sigma) {
+    Detection d;
+    d.value = p + sigma * Vec3(rng.normal(), rng.normal(), rng.normal());
+    d.covariance = MeasCov::Identity(3, 3) * 4.0;
+    d.origin = origin;
+    detections.push_back(d);
+  }
+};
+
+const char* const kAdaptedTracker =
+    "{ estimator: { type: filter.kalman, q: 0.1 m2/s3 },\n"
+    "  adapters: [ { type: adapt.innovation_r, window: 10, warmup: 5 } ],\n"
+    "  associator: { type: assoc.gnn, gate_probability: 0.999999 },\n"
+    "  initiator: { type: init.m_of_n, m: 2, n: 3, max_speed: 100 m/s },\n"
+    "  deleter: { type: delete.misses, max_misses: 3 } }";
+
+// The adapted sigma_x annotation of the track following `target` in set `s`; NaN when none.
+double adapted_sigma(const SetCollector::Seen& s, std::uint32_t target, std::uint64_t* id = nullptr) {
+  for (const TrackEstimate& t : s.tracks)
+    if (t.status != TrackStatus::Deleted && t.estimate.target == target && t.estimate.annotation_count == 3) {
+      if (id) *id = t.id;
+      return t.estimate.annotations[0];
+    }
+  return std::numeric_limits<double>::quiet_NaN();
+}
+
+}  // namespace
+
+// adapt.innovation_r per track: the noisy target's track learns its larger R, the other keeps
+// the nominal 2 m; after the noisy track is deleted, a new track in its slot starts from the
+// measurements' own R again, nothing of the slot's previous adapter state.
+TEST_CASE("per-track adapters: each track adapts its own R") {
+  auto n = test::make("tracker.multi", kAdaptedTracker);
+  SetCollector out;
+  out.attach_to(*n);
+  auto run_once = [&](std::uint64_t run) {
+    out.sets.clear();
+    test::start_run(*n, run);
+    NoisyPair sc;
+    for (int k = 0; k < 60; ++k) n->on_scan(sc.scan_at(k), 0);             // both, target 2 noisy
+    for (int k = 60; k < 66; ++k) n->on_scan(sc.scan_at(k, false), 0);     // target 2 gone: deleted
+    for (int k = 66; k < 70; ++k) n->on_scan(sc.scan_at(k, true, 2.0), 0);  // back, as noisy as claimed
+    n->end_run();
+    return out.sets;
+  };
+  const auto sets = run_once(0);
+  REQUIRE(sets.size() == 70);
+  std::uint64_t quiet_id = 0, noisy_id = 0;
+  const double quiet = adapted_sigma(sets[59], 1, &quiet_id), noisy = adapted_sigma(sets[59], 2, &noisy_id);
+  INFO("adapted sigma_x at t = 59 s: target 1 " << quiet << " m, target 2 " << noisy << " m");
+  CHECK(quiet == Approx(2.0).margin(0.8));
+  CHECK(noisy == Approx(8.0).margin(3.0));
+  CHECK(noisy_id != quiet_id);
+  // One track per target all along the first phase (the noisy one was not lost and restarted).
+  for (int k = 10; k < 60; ++k) {
+    std::uint64_t id1 = 0, id2 = 0;
+    adapted_sigma(sets[static_cast<size_t>(k)], 1, &id1);
+    adapted_sigma(sets[static_cast<size_t>(k)], 2, &id2);
+    CHECK(id1 == quiet_id);
+    CHECK(id2 == noisy_id);
+  }
+  // The noisy track deleted while its target is gone; the target's new track (started from the
+  // detections at t = 66, 67 s, in the noisy one's slot, the only spare) has a new id and at its
+  // start the measurements' own sigma, 2 m exactly, then stays near it.
+  std::uint64_t gone_id = 0;
+  CHECK(std::isnan(adapted_sigma(sets[65], 2, &gone_id)));
+  std::uint64_t fresh_id = 0;
+  const double fresh = adapted_sigma(sets[67], 2, &fresh_id);
+  CHECK(fresh_id != noisy_id);
+  CHECK(fresh_id != 0);
+  CHECK(fresh == Approx(2.0).epsilon(1e-12));
+  CHECK(adapted_sigma(sets[69], 2) == Approx(2.0).margin(1.0));
+  CHECK(adapted_sigma(sets[69], 1) == Approx(quiet).margin(0.5));
+  // Deterministic: the same run again on the same node (its slots reused) gives the same values.
+  const auto again = run_once(0);
+  REQUIRE(again.size() == sets.size());
+  for (size_t k = 0; k < sets.size(); ++k) {
+    REQUIRE(again[k].tracks.size() == sets[k].tracks.size());
+    for (size_t i = 0; i < sets[k].tracks.size(); ++i) {
+      const Estimate &a = sets[k].tracks[i].estimate, &b = again[k].tracks[i].estimate;
+      CHECK(a.enu == b.enu);
+      REQUIRE(a.annotation_count == b.annotation_count);
+      for (int j = 0; j < a.annotation_count; ++j)
+        CHECK((a.annotations[j] == b.annotations[j] || (std::isnan(a.annotations[j]) && std::isnan(b.annotations[j]))));
+    }
+  }
+}
+
+// What the estimator cannot offer is refused when the tracker is made, at the entry's line:
+// adapt.range_r writes a spherical R, filter.kalman's is Cartesian.
+TEST_CASE("per-track adapters the estimator cannot serve") {
+  const std::string yaml =
+      "{ estimator: { type: filter.kalman },\n"
+      "  adapters: [ { type: adapt.innovation_r },\n"
+      "              { type: adapt.range_r, alpha: 400 urad2, beta: 900 urad2, reference_range: 10 km } ],\n"
+      "  associator: { type: assoc.gnn }, initiator: { type: init.m_of_n, max_speed: 1 m/s },\n"
+      "  deleter: { type: delete.misses } }";
+  try {
+    test::make("tracker.multi", yaml);
+    FAIL("adapt.range_r on a filter.kalman estimator was accepted");
+  } catch (const ConfigError& e) {
+    INFO(e.what());
+    CHECK(std::string(e.what()).find("adapt.range_r") != std::string::npos);
+    CHECK(std::string(e.what()).find("spherical") != std::string::npos);
+    CHECK(e.where().line == 3);
+  }
+  // Only adapters may be given there.
+  CHECK_THROWS_WITH(test::make("tracker.multi",
+                               "{ estimator: { type: filter.kalman }, adapters: [ { type: filter.kalman } ], "
+                               "associator: { type: assoc.gnn }, initiator: { type: init.m_of_n, max_speed: 1 m/s }, "
+                               "deleter: { type: delete.misses } }"),
+                    Catch::Contains("filter.kalman"));
 }

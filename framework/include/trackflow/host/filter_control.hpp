@@ -30,6 +30,12 @@ class FilterControl {
     f.adapters_[f.adapter_count_++] = &a;
     return true;
   }
+  // The annotation values `f` stamps on its next estimate (what Filter::publish does), for a
+  // Filter that is no node and publishes nothing itself (TrackAdapters, a tracker's track).
+  static void stamp_annotations(const Filter& f, Estimate& e) {
+    e.annotation_count = f.annotation_count_;
+    for (int i = 0; i < f.annotation_count_; ++i) e.annotations[i] = f.annotation_values_[i];
+  }
   // Remembers the process noise as configured (once, before any run) ...
   static void save_configured_noise(Filter& f) {
     const ProcessNoiseHandle q = f.noise().process;
