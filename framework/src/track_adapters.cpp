@@ -1,6 +1,5 @@
 // Purpose: TrackAdapters — a tracker's per-track adapters: made and checked like `attach_to:` adapters (host::FilterControl), restarted per track, called around each of the track's updates.
 #include <trackflow/error.hpp>
-#include <trackflow/host/adapter_part.hpp>
 #include <trackflow/host/filter_control.hpp>
 #include <trackflow/track_adapters.hpp>
 
@@ -13,15 +12,12 @@ namespace trackflow {
 using host::FilterControl;
 
 std::unique_ptr<Adapter> create_adapter(const NestedComponent& entry) {
-  std::unique_ptr<TrackerPart> part = entry.part_factory ? entry.part_factory(entry.params) : nullptr;
-  auto* wrapped = dynamic_cast<host::AdapterPart*>(part.get());
-  if (!wrapped)
+  std::unique_ptr<Component> made = entry.component_factory ? entry.component_factory(entry.params) : nullptr;
+  auto* adapter = dynamic_cast<Adapter*>(made.get());
+  if (!adapter)
     throw ConfigError("type '" + entry.type + "' is not an adapter, so it cannot run here", entry.type_where,
                       entry.params.node());
-  auto* adapter = dynamic_cast<Adapter*>(wrapped->adapter.get());
-  if (!adapter)
-    throw ConfigError("the factory of adapter '" + entry.type + "' made no Adapter", entry.type_where, entry.params.node());
-  wrapped->adapter.release();
+  made.release();
   return std::unique_ptr<Adapter>(adapter);
 }
 
@@ -40,6 +36,8 @@ TrackAdapters::TrackAdapters(const std::vector<NestedComponent>& adapters, Estim
                             " annotations per track)",
                         entry.type_where, entry.params.node());
     adapters_.push_back(std::move(a));
+    frames_.push_back(entry.accepts_frames);
+    types_.push_back(entry.type);
   }
   // The estimator's noise now is the configured one; start_track puts it back for every track.
   FilterControl::save_configured_noise(*this);
@@ -64,6 +62,12 @@ void TrackAdapters::start_track(const RunContext& ctx) {
 }
 
 void TrackAdapters::before_update(const Measurement& m, int dim) {
+  // A frame an adapter does not declare (a 2-D plot reaching an adapter of three channels) would be
+  // passed over by it without a word: refused instead, as graph.cpp refuses it on a filter node.
+  for (std::size_t i = 0; i < adapters_.size(); ++i)
+    if (m.valid && !(frames_[i] & mask(m.frame)))
+      throw DataError(who_ + ": adapter " + types_[i] + " takes " + frame_names(frames_[i]) + " measurements, but the " +
+                      "detection at t=" + std::to_string(m.time) + " s is " + to_string(m.frame));
   for (const auto& a : adapters_) a->before_update(m, *this);
   const MeasCov& R = estimator_->measurement_noise();
   if (m.valid && (R.rows() < dim || R.cols() < dim))

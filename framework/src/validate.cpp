@@ -1,5 +1,4 @@
 // Purpose: validation of node parameters against their declarations (type, unit dimension, range).
-#include <trackflow/host/adapter_part.hpp>
 #include <trackflow/host/suggest.hpp>
 #include <trackflow/host/validate.hpp>
 
@@ -98,13 +97,8 @@ NestedComponent parse_component(const ParamSpec& s, const Value& v, const std::s
   NestedComponent out{decl->type, validate_params(decl->params, rest, node, v.loc, types), type->loc, {}};
   out.estimator_factory = decl->create_estimator;
   out.part_factory = decl->create_part;
-  // An adapter's own factory, wrapped as a part (host/adapter_part.hpp), for create_adapter (track_adapters.hpp).
-  if (decl->kind == ComponentKind::Adapter && decl->create)
-    out.part_factory = [create = decl->create](const Params& p) -> std::unique_ptr<TrackerPart> {
-      auto part = std::make_unique<AdapterPart>();
-      part->adapter = create(p);
-      return part;
-    };
+  out.component_factory = decl->create;
+  out.accepts_frames = decl->accepts_frames;
   return out;
 }
 

@@ -99,5 +99,12 @@ nodes:
       deleter: { type: delete.misses, max_misses: 3 }
 YAML
 expect_run "tracker.multi tracks a polar detection log" 0 "tracks_confirmed_per_run +2$" -- "$TF" run "$TMP/polar_tracks.yaml"
+# A per-track adapter of three channels on polar detections: refused when the first one reaches it.
+sed 's/      deleter: { type: delete.misses, max_misses: 3 }/      deleter: { type: delete.misses, max_misses: 3 }\n      adapters: [{ type: adapt.range_r, alpha: 400 urad2, beta: 900 urad2, reference_range: 10 km }]/' \
+  "$TMP/polar_tracks.yaml" > "$TMP/polar_adapted.yaml"
+grep -q "adapt.range_r" "$TMP/polar_adapted.yaml" || fail "the adapter was not added to the test pipeline"
+expect_run "a per-track adapter refuses a frame it does not take" 2 \
+  "adapter adapt.range_r takes spherical measurements, but the detection at t=0.000000 s is polar" -- \
+  "$TF" run "$TMP/polar_adapted.yaml"
 
 finish

@@ -104,6 +104,7 @@ class Params;
 struct NestedComponent;
 class Estimator;
 class TrackerPart;
+class Component;
 
 struct ParamValue {
   ParamType type = ParamType::Real;
@@ -183,6 +184,11 @@ struct NestedComponent {
   // The nested type's tracker-part factory (ComponentDecl::create_part), likewise; make_part
   // (tracker.hpp) creates the part.
   std::function<std::unique_ptr<TrackerPart>(const Params&)> part_factory;
+  // The nested type's own component factory (ComponentDecl::create), for a component composed of
+  // components that are not parts or estimators (tracker.multi's per-track adapters,
+  // track_adapters.hpp), and the measurement frames it declares it accepts (ComponentDecl::accepts_frames).
+  std::function<std::unique_ptr<Component>(const Params&)> component_factory;
+  FrameMask accepts_frames = kAnyFrame;
 
   // The nested type's estimator from `params`, for a component composed of estimators (filter.imm's
   // modes). Throws ConfigError at the `type:` value when the type declares no estimator.

@@ -13,11 +13,9 @@
 
 namespace trackflow {
 
-// A new instance of the adapter a nested `{type: adapt..., ...}` entry names. Throws ConfigError at
-// the entry's `type:` value when the type is not an adapter. (The host's validation puts an adapter
-// type's ComponentDecl::create into NestedComponent::part_factory, wrapped as a tracker part,
-// host/adapter_part.hpp: NestedComponent has no field for it, and a new one would change its
-// layout, the plugin ABI.)
+// A new instance of the adapter a nested `{type: adapt..., ...}` entry names (its type's
+// ComponentDecl::create, NestedComponent::component_factory). Throws ConfigError at the entry's
+// `type:` value when the type is not an adapter.
 BOOST_SYMBOL_VISIBLE std::unique_ptr<Adapter> create_adapter(const NestedComponent& entry);
 
 // A tracker that takes adapters (a component-list parameter of kind Adapter, e.g. tracker.multi's
@@ -57,7 +55,8 @@ class BOOST_SYMBOL_VISIBLE TrackAdapters final : public Filter {
   // A new track in this slot, before its first measurement: process noise as configured, no
   // annotation values, every adapter's start_run(ctx), no restart requested.
   void start_track(const RunContext& ctx);
-  // Throws DataError when an adapter left an R smaller than dim x dim.
+  // Throws DataError when m's frame is one an adapter does not declare (ComponentDecl::accepts_frames)
+  // or when an adapter left an R smaller than dim x dim.
   void before_update(const Measurement& m, int dim);
   void after_update(const Measurement& m, Estimate& e);
   // The adapters' current values onto e (annotation_count included): a track's estimate between updates.
@@ -80,6 +79,8 @@ class BOOST_SYMBOL_VISIBLE TrackAdapters final : public Filter {
   Estimator* estimator_;
   std::string who_;
   std::vector<std::unique_ptr<Adapter>> adapters_;
+  std::vector<FrameMask> frames_;   // each adapter's declared measurement frames
+  std::vector<std::string> types_;  // and its type, for messages
   mutable Estimate scratch_;        // read_covariance's
   bool restart_requested_ = false;
 };
