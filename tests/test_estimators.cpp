@@ -33,6 +33,13 @@ std::vector<Measurement> track(Frame frame, int steps) {
       const Vec3 sigma(10.0, 1e-3, 1e-3);
       m.value = Vec3(r + sigma(0) * rng.normal(), wrap_angle(az + sigma(1) * rng.normal()), el + sigma(2) * rng.normal());
       m.covariance = Vec3(sigma.array().square()).asDiagonal();
+    } else if (frame == Frame::Polar) {  // a 2-D radar: [r, az] of the target's ground position
+      const double r = std::hypot(p.x(), p.y()), az = std::atan2(p.x(), p.y());
+      m.value = Eigen::Vector2d(r + 10.0 * rng.normal(), wrap_angle(az + 1e-3 * rng.normal()));
+      m.covariance = Eigen::Vector2d(100.0, 1e-6).asDiagonal();
+    } else if (frame == Frame::Planar) {
+      m.value = Eigen::Vector2d(p.x() + 20.0 * rng.normal(), p.y() + 20.0 * rng.normal());
+      m.covariance = MeasCov::Identity(2, 2) * 400.0;
     } else {
       m.value = p + 20.0 * Vec3(rng.normal(), rng.normal(), rng.normal());
       m.covariance = MeasCov::Identity(3, 3) * 400.0;
@@ -69,6 +76,9 @@ const std::vector<Case>& cases() {
       {"filter.imm", "{modes: [{motion: constant_velocity, q: 1 m2/s3}, {motion: constant_acceleration, q_jerk: 100 m2/s5}], transition: [0.95, 0.05, 0.05, 0.95]}", Frame::Spherical},
       {"filter.imm", "{modes: [{motion: constant_acceleration}, {motion: singer, singer_alpha: 1 1/s, singer_sigma: 20 m/s2}], transition: [0.9, 0.1, 0.1, 0.9]}", Frame::Spherical},
       {"filter.refraction_ekf", "{}", Frame::Spherical},
+      // The 2-D frames (SDK 0.7): a 2-D radar's polar plots, a planar sensor's x-y ones.
+      {"filter.ekf", "{}", Frame::Polar},
+      {"filter.kalman", "{q: 1 m2/s3}", Frame::Planar},
   };
   return c;
 }
@@ -85,14 +95,15 @@ void run(Estimator& e, Track& t, const std::vector<Measurement>& ms, Before&& be
     const double T = m.time - last;
     last = t.time = m.time;
     e.measurement_noise() = m.covariance;
+    const int dim = static_cast<int>(m.value.size());
     if (!formed) {
-      formed = e.initiate(m, 3);
+      formed = e.initiate(m, dim);
       continue;
     }
     if (T > 0.0) e.predict(T);
     before(m);
     t.e.updated = false;
-    const bool used = e.update(m, 3);
+    const bool used = e.update(m, dim);
     after(m, used);
   }
 }
@@ -147,7 +158,7 @@ TEST_CASE("predicted measurement is what the update uses") {
           const Eigen::VectorXd nud = nu;
           CHECK(std::log(Sd.determinant()) == Approx(p.log_det_S).epsilon(1e-8));
           MeasVec r = m.value.head(p.z.size()) - p.z;
-          if (c.frame == Frame::Spherical) r(1) = wrap_angle(r(1));
+          wrap_residual(c.frame, r);
           const Eigen::VectorXd rd = r;
           const Eigen::MatrixXd Sp = p.S;
           CHECK(rd.dot(Sp.ldlt().solve(rd)) == Approx(nud.dot(Sd.ldlt().solve(nud))).epsilon(1e-7));
@@ -180,7 +191,8 @@ TEST_CASE("a clone runs on exactly as its original") {
       e->measurement_noise() = copy->measurement_noise() = m.covariance;
       e->predict(T);
       copy->predict(T);
-      REQUIRE(e->update(m, 3) == copy->update(m, 3));
+      const int dim = static_cast<int>(m.value.size());
+      REQUIRE(e->update(m, dim) == copy->update(m, dim));
     }
     Estimate a, b;
     e->fill(a);

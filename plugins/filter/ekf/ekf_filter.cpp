@@ -32,6 +32,23 @@ class ExtendedKalmanFilter final
   static std::vector<std::string> counter_names() { return {"azimuth_dropped", "azimuth_deweighted"}; }
   static constexpr FrameMask kFrames = mask(Frame::Spherical) | mask(Frame::Polar);
 
+  // The update's own linearisation with z = 0 (nu = -h, the zenith conditioning included), so a
+  // tracker's gate sees exactly the S the update will use: what Estimator::predicted_by_update
+  // gives, without copying the estimator (which allocates) per track and scan.
+  bool predict_measurement(const SensorFrame& s, const MeasCov& R, PredictedMeasurement& p) const override {
+    const int dim = static_cast<int>(R.rows());
+    const int positions = position_values(s.frame);
+    if (!(kFrames & mask(s.frame)) || R.cols() != dim || (dim != positions && dim != positions + 1)) return false;
+    Measurement m;
+    static_cast<SensorFrame&>(m) = s;
+    m.time = this->time();
+    m.has_range_rate = dim == positions + 1;
+    m.value = MeasVec::Zero(dim);
+    m.covariance = R;
+    if (s.frame == Frame::Polar) return dim == 3 ? predicted<3, true>(m, R, p) : predicted<2, true>(m, R, p);
+    return dim == 4 ? predicted<4, false>(m, R, p) : predicted<3, false>(m, R, p);
+  }
+
  private:
   enum Counter { kAzimuthDropped, kAzimuthDeweighted };
 
@@ -56,6 +73,26 @@ class ExtendedKalmanFilter final
         x_, P_, idx_, m, Eigen::Matrix<double, M, M>(R_.template topLeftCorner<M, M>()), in);
     return report<M>(m, outcome, in);
   }
+  template <int M, bool Polar>
+  bool predicted(const Measurement& m, const MeasCov& R, PredictedMeasurement& p) const {
+    cartesian_filter::EkfInnovation<M> in;
+    Eigen::Matrix<double, N, M> PHt;
+    const Eigen::Matrix<double, M, M> Rm = R.template topLeftCorner<M, M>();
+    const bool curvature = this->settings().zenith == cartesian_filter::Settings::Zenith::Curvature;
+    cartesian_filter::EkfOutcome outcome;
+    if constexpr (Polar)
+      outcome = cartesian_filter::ekf_polar_linearise<N, M>(x_, P_, idx_, m, Rm, in, PHt);
+    else
+      outcome = cartesian_filter::ekf_radar_linearise<N, M>(x_, P_, idx_, m, Rm, curvature, in, PHt);
+    if (outcome != cartesian_filter::EkfOutcome::Used) return false;
+    p.z = -in.nu;
+    wrap_residual(m.frame, p.z);
+    p.S = in.S;
+    for (int i = 0; i < M; ++i)
+      for (int j = i + 1; j < M; ++j) p.S(i, j) = p.S(j, i);  // the lower triangle mirrored, as the update does
+    return set_log_det(p);
+  }
+
   template <int M>
   bool report(const Measurement& m, cartesian_filter::EkfOutcome outcome, const cartesian_filter::EkfInnovation<M>& in) {
     if (outcome == cartesian_filter::EkfOutcome::AtSensor) {

@@ -20,9 +20,12 @@ namespace trackflow::cartesian_filter {
 // Near the vertical of the radar (horizontal range below kZenithFraction r, only off the plane) the
 // azimuth row is dropped as in ekf_radar_update; there is no curvature conditioning (its derivation
 // is for [r, az, el]).
+// ekf_polar_linearise: the update up to S (nu, S's lower triangle, P H'), changing nothing, as
+// ekf_radar_linearise.
 template <int N, int M>
-EkfOutcome ekf_polar_update(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double, N, N>& P, const int idx[6],
-                            const Measurement& m, const Eigen::Matrix<double, M, M>& R_measured, EkfInnovation<M>& out) {
+EkfOutcome ekf_polar_linearise(const Eigen::Matrix<double, N, 1>& x, const Eigen::Matrix<double, N, N>& P,
+                               const int idx[6], const Measurement& m, const Eigen::Matrix<double, M, M>& R_measured,
+                               EkfInnovation<M>& out, Eigen::Matrix<double, N, M>& PHt) {
   static_assert(M == 2 || M == 3);
   constexpr int MS = M + 1;  // the spherical model with elevation: [r, az, el(, rdot)]
   using MatM = Eigen::Matrix<double, M, M>;
@@ -65,7 +68,6 @@ EkfOutcome ekf_polar_update(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double
     }
   }
   // Rows r and az depend on the position only; the range rate's also on the velocity.
-  Eigen::Matrix<double, N, M> PHt;
   for (int k = 0; k < M; ++k)
     for (int r = 0; r < N; ++r) {
       double s = P(r, idx[0]) * J(k, 0) + P(r, idx[1]) * J(k, 1) + P(r, idx[2]) * J(k, 2);
@@ -81,7 +83,15 @@ EkfOutcome ekf_polar_update(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double
       S(l, k) = s;
     }
   out.nu = nu;
-  if (joseph_update_cross<N, M>(x, P, nu, PHt, S, out.nis, nullptr, &out.det_S)) return EkfOutcome::Used;
+  return EkfOutcome::Used;
+}
+
+template <int N, int M>
+EkfOutcome ekf_polar_update(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double, N, N>& P, const int idx[6],
+                            const Measurement& m, const Eigen::Matrix<double, M, M>& R_measured, EkfInnovation<M>& out) {
+  Eigen::Matrix<double, N, M> PHt;
+  if (ekf_polar_linearise<N, M>(x, P, idx, m, R_measured, out, PHt) == EkfOutcome::AtSensor) return EkfOutcome::AtSensor;
+  if (joseph_update_cross<N, M>(x, P, out.nu, PHt, out.S, out.nis, nullptr, &out.det_S)) return EkfOutcome::Used;
   return EkfOutcome::NotPositiveDefinite;
 }
 

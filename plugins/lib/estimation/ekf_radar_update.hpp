@@ -66,10 +66,15 @@ void condition_near_zenith(const Eigen::Matrix<double, N, N>& P, const int idx[6
 // curvature). H = dh/dx is non-zero only in the position columns (and, for the range rate, the
 // velocity columns): P H' and H P H' are formed from those (kalman.hpp, joseph_update_cross),
 // never the M x N H or an N x N x N product.
+//
+// ekf_radar_linearise is the update up to S: the innovation nu = z - h (azimuth wrapped, zenith
+// conditioned), S's lower triangle and P H'; it changes nothing, so a track's predicted measurement
+// (Estimator::predict_measurement, with z = 0: nu = -h) is the update's own linearisation, without
+// a copy of the estimator.
 template <int N, int M>
-EkfOutcome ekf_radar_update(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double, N, N>& P, const int idx[6],
-                            const Measurement& m, const Eigen::Matrix<double, M, M>& R_measured, bool curvature,
-                            EkfInnovation<M>& out) {
+EkfOutcome ekf_radar_linearise(const Eigen::Matrix<double, N, 1>& x, const Eigen::Matrix<double, N, N>& P,
+                               const int idx[6], const Measurement& m, const Eigen::Matrix<double, M, M>& R_measured,
+                               bool curvature, EkfInnovation<M>& out, Eigen::Matrix<double, N, M>& PHt) {
   using MatM = Eigen::Matrix<double, M, M>;
   out.azimuth_dropped = out.azimuth_deweighted = false;
   // In the sensor's own axes (a tilted sensor: Measurement::sensor_axes); J is turned back into
@@ -96,7 +101,6 @@ EkfOutcome ekf_radar_update(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double
     }
   }
   // Rows r, az, el depend on the position only; the range rate's also on the velocity.
-  Eigen::Matrix<double, N, M> PHt;
   for (int k = 0; k < M; ++k)
     for (int r = 0; r < N; ++r) {
       double s = P(r, idx[0]) * J(k, 0) + P(r, idx[1]) * J(k, 1) + P(r, idx[2]) * J(k, 2);
@@ -112,7 +116,17 @@ EkfOutcome ekf_radar_update(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double
       S(l, k) = s;
     }
   out.nu = nu;
-  if (joseph_update_cross<N, M>(x, P, nu, PHt, S, out.nis, nullptr, &out.det_S)) return EkfOutcome::Used;
+  return EkfOutcome::Used;
+}
+
+template <int N, int M>
+EkfOutcome ekf_radar_update(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double, N, N>& P, const int idx[6],
+                            const Measurement& m, const Eigen::Matrix<double, M, M>& R_measured, bool curvature,
+                            EkfInnovation<M>& out) {
+  Eigen::Matrix<double, N, M> PHt;
+  if (ekf_radar_linearise<N, M>(x, P, idx, m, R_measured, curvature, out, PHt) == EkfOutcome::AtSensor)
+    return EkfOutcome::AtSensor;
+  if (joseph_update_cross<N, M>(x, P, out.nu, PHt, out.S, out.nis, nullptr, &out.det_S)) return EkfOutcome::Used;
   return EkfOutcome::NotPositiveDefinite;
 }
 
