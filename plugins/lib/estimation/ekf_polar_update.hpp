@@ -56,32 +56,7 @@ EkfOutcome ekf_polar_linearise(const Eigen::Matrix<double, N, 1>& x, const Eigen
     R.col(1).setZero();
     R(1, 1) = raz > 0.0 ? raz : 1.0;
   }
-  if (!m.sensor_level) {  // dh/dx_frame = dh/dd_sensor A'
-    const Mat3 At = m.sensor_axes.transpose();
-    for (int k = 0; k < M; ++k) {
-      const Eigen::RowVector3d jp = J.template block<1, 3>(k, 0) * At;
-      J.template block<1, 3>(k, 0) = jp;
-      if (k == 2) {
-        const Eigen::RowVector3d jv = J.template block<1, 3>(k, 3) * At;
-        J.template block<1, 3>(k, 3) = jv;
-      }
-    }
-  }
-  // Rows r and az depend on the position only; the range rate's also on the velocity.
-  for (int k = 0; k < M; ++k)
-    for (int r = 0; r < N; ++r) {
-      double s = P(r, idx[0]) * J(k, 0) + P(r, idx[1]) * J(k, 1) + P(r, idx[2]) * J(k, 2);
-      if (k == 2) s += P(r, idx[3]) * J(k, 3) + P(r, idx[4]) * J(k, 4) + P(r, idx[5]) * J(k, 5);
-      PHt(r, k) = s;
-    }
-  MatM& S = out.S;
-  for (int k = 0; k < M; ++k)
-    for (int l = k; l < M; ++l) {
-      const int c = l == 2 ? 6 : 3;
-      double s = R(l, k);
-      for (int j = 0; j < c; ++j) s += J(l, j) * PHt(idx[j], k);
-      S(l, k) = s;
-    }
+  radar_gain_terms<N, M>(P, idx, m, M == 3 ? 2 : -1, J, R, PHt, out.S);
   out.nu = nu;
   return EkfOutcome::Used;
 }

@@ -61,6 +61,41 @@ void condition_near_zenith(const Eigen::Matrix<double, N, N>& P, const int idx[6
   }
 }
 
+// P H' and the lower triangle of S = H P H' + R from a radar Jacobian J (M x 6, columns
+// [x y z vx vy vz] in the sensor's axes; turned into the frame's here for a tilted sensor,
+// dh/dx_frame = dh/dd_sensor A') whose rows depend on the position only, but for row `rate_row`
+// (the range rate, also on the velocity; -1: none). Shared by the [r, az, el(, rdot)] update below
+// and the 2-D radar's [r, az(, rdot)] one (ekf_polar_update.hpp).
+template <int N, int M>
+void radar_gain_terms(const Eigen::Matrix<double, N, N>& P, const int idx[6], const Measurement& m, int rate_row,
+                      Eigen::Matrix<double, M, 6>& J, const Eigen::Matrix<double, M, M>& R,
+                      Eigen::Matrix<double, N, M>& PHt, Eigen::Matrix<double, M, M>& S) {
+  if (!m.sensor_level) {
+    const Mat3 At = m.sensor_axes.transpose();
+    for (int k = 0; k < M; ++k) {
+      const Eigen::RowVector3d jp = J.template block<1, 3>(k, 0) * At;
+      J.template block<1, 3>(k, 0) = jp;
+      if (k == rate_row) {
+        const Eigen::RowVector3d jv = J.template block<1, 3>(k, 3) * At;
+        J.template block<1, 3>(k, 3) = jv;
+      }
+    }
+  }
+  for (int k = 0; k < M; ++k)
+    for (int r = 0; r < N; ++r) {
+      double s = P(r, idx[0]) * J(k, 0) + P(r, idx[1]) * J(k, 1) + P(r, idx[2]) * J(k, 2);
+      if (k == rate_row) s += P(r, idx[3]) * J(k, 3) + P(r, idx[4]) * J(k, 4) + P(r, idx[5]) * J(k, 5);
+      PHt(r, k) = s;
+    }
+  for (int k = 0; k < M; ++k)
+    for (int l = k; l < M; ++l) {
+      const int c = l == rate_row ? 6 : 3;  // H P H' = H (P H'): row l of H against column k of P H'
+      double s = R(l, k);
+      for (int j = 0; j < c; ++j) s += J(l, j) * PHt(idx[j], k);
+      S(l, k) = s;
+    }
+}
+
 // h linearised at the predicted state x (idx: the state indices of [x y z vx vy vz]); R is the
 // measurement's M x M covariance; `curvature`: condition near the zenith (filter.ekf's zenith:
 // curvature). H = dh/dx is non-zero only in the position columns (and, for the range rate, the
@@ -89,32 +124,7 @@ EkfOutcome ekf_radar_linearise(const Eigen::Matrix<double, N, 1>& x, const Eigen
   SphericalVec<M> nu = spherical_residual<M>(z, h);
   MatM R = R_measured;
   if (curvature) condition_near_zenith<N, M>(P, idx, m, d, sing, J, nu, R, out);
-  if (!m.sensor_level) {  // dh/dx_frame = dh/dd_sensor A' (position and velocity columns)
-    const Mat3 At = m.sensor_axes.transpose();
-    for (int k = 0; k < M; ++k) {
-      const Eigen::RowVector3d jp = J.template block<1, 3>(k, 0) * At;
-      J.template block<1, 3>(k, 0) = jp;
-      if (k == 3) {
-        const Eigen::RowVector3d jv = J.template block<1, 3>(k, 3) * At;
-        J.template block<1, 3>(k, 3) = jv;
-      }
-    }
-  }
-  // Rows r, az, el depend on the position only; the range rate's also on the velocity.
-  for (int k = 0; k < M; ++k)
-    for (int r = 0; r < N; ++r) {
-      double s = P(r, idx[0]) * J(k, 0) + P(r, idx[1]) * J(k, 1) + P(r, idx[2]) * J(k, 2);
-      if (k == 3) s += P(r, idx[3]) * J(k, 3) + P(r, idx[4]) * J(k, 4) + P(r, idx[5]) * J(k, 5);
-      PHt(r, k) = s;
-    }
-  MatM& S = out.S;
-  for (int k = 0; k < M; ++k)
-    for (int l = k; l < M; ++l) {
-      const int c = l == 3 ? 6 : 3;  // H P H' = H (P H'): row l of H against column k of P H'
-      double s = R(l, k);
-      for (int j = 0; j < c; ++j) s += J(l, j) * PHt(idx[j], k);
-      S(l, k) = s;
-    }
+  radar_gain_terms<N, M>(P, idx, m, M == 4 ? 3 : -1, J, R, PHt, out.S);
   out.nu = nu;
   return EkfOutcome::Used;
 }
