@@ -299,3 +299,35 @@ TEST_CASE("filters declare the one transition-model block") {
   }
   CHECK(users == 6);
 }
+
+// The one-point start (Estimator::initiate_one_point): position and its covariance from the
+// measurement (converted for a radar), velocity 0 with variance velocity_sigma^2 per axis, no
+// position-velocity cross term; the estimators without it say so.
+TEST_CASE("one-point starts: at rest with the velocity prior") {
+  for (const Case& c : cases()) {
+    INFO(c.type << " " << c.params << " frame " << int(c.frame));
+    auto e = test::fixture().make_estimator(c.type, c.params);
+    const bool can = c.type == "filter.kalman" || c.type == "filter.ekf" || c.type == "filter.ukf";
+    CHECK(e->starts_from_one_point() == can);
+    if (!can) continue;
+    Track t;
+    e->bind(t);
+    t.estimate = &t.e;
+    const Measurement m = track(c.frame, 1).front();
+    e->reset();
+    e->measurement_noise() = m.covariance;
+    REQUIRE(e->initiate_one_point(m, static_cast<int>(m.value.size()), 30.0));
+    Estimate x;
+    e->fill(x);
+    const Vec3 p = measured_position(m);
+    CHECK((x.enu.head<3>() - p).norm() < 1e-9 * p.norm());
+    CHECK(x.enu.tail<3>().isZero());
+    const bool planar = c.frame == Frame::Polar || c.frame == Frame::Planar;
+    for (int a = 0; a < 3; ++a) {
+      CHECK(x.enu_covariance(3 + a, 3 + a) == Approx(planar && a == 2 ? 0.0 : 900.0));
+      for (int b = 0; b < 3; ++b) CHECK(x.enu_covariance(a, 3 + b) == 0.0);
+    }
+    const Mat3 Rp = measured_position_covariance(m, m.covariance);
+    CHECK((x.enu_covariance.topLeftCorner<3, 3>() - Rp).norm() < 1e-9 * Rp.norm());
+  }
+}

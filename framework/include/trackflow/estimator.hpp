@@ -123,6 +123,12 @@ class Estimator {
   virtual bool assign(const StateVec& /*x*/, const StateCov& /*P*/) { return false; }
   // Optional: the kinematic model the estimator predicts with, as configured (Filter::transition_model).
   virtual const TransitionModel* transition_model() const { return nullptr; }
+  // Optional: a one-point start (after reset()) — position and its covariance from m alone, velocity
+  // 0 with standard deviation velocity_sigma per axis (an initiator's prior bounded by a maximum
+  // speed), higher derivatives 0 with the estimator's own initial sigmas. starts_from_one_point()
+  // says whether it can; false from initiate_one_point: not started (warn() why).
+  virtual bool starts_from_one_point() const { return false; }
+  virtual bool initiate_one_point(const Measurement& /*m*/, int /*dim*/, double /*velocity_sigma*/) { return false; }
 
   const MeasurementSpec& measurement_spec() const { return spec_; }
   void bind(TrackContext& track) { track_ = &track; }

@@ -74,10 +74,13 @@ class BOOST_SYMBOL_VISIBLE Associator : public TrackerPart {
 // A new track's first detections: `first` from an earlier scan (time first_time), `second` the
 // index of a detection in the current scan; the tracker initiates a fresh estimator with both.
 // `score`: the track score L after the two (0: they are the reference the later looks add to).
+// velocity_sigma > 0: a one-point start — the detection `second` alone, at rest with velocity
+// standard deviation velocity_sigma per axis (Estimator::initiate_one_point; `first` is not used).
 struct TrackStart {
   Measurement first;
   int second = -1;
   double score = 0.0;
+  double velocity_sigma = 0.0;
 };
 
 // Track initiation and confirmation.
@@ -91,6 +94,9 @@ class BOOST_SYMBOL_VISIBLE Initiator : public TrackerPart {
   virtual bool confirmed(const TrackView& track) const = 0;
   // A tentative track that will not be confirmed any more: deleted.
   virtual bool failed(const TrackView& track) const = 0;
+  // Whether it makes one-point starts (TrackStart::velocity_sigma > 0): the tracker then refuses,
+  // before the run, an estimator that cannot start from one point.
+  virtual bool one_point_starts() const { return false; }
   // A new run: forget the detections kept from the previous one.
   virtual void reset() = 0;
 };

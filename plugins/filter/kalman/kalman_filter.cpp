@@ -163,6 +163,34 @@ class KalmanEstimator final : public Estimator {
     return true;
   }
 
+  // One-point start: position the measurement's, P_pp its R; velocity 0 with variance
+  // velocity_sigma^2 per axis (none on z for a planar point), CA acceleration 0 with
+  // initial_sigma_acceleration; no cross terms between position and velocity.
+  bool starts_from_one_point() const override { return true; }
+  bool initiate_one_point(const Measurement& m, int, double velocity_sigma) override {
+    const bool planar = m.frame == Frame::Planar;
+    const Vec3 z = measured_position(m);
+    Mat3 R = Mat3::Zero();
+    if (planar)
+      R.topLeftCorner<2, 2>() = R_.topLeftCorner(2, 2);
+    else
+      R = R_.topLeftCorner(3, 3);
+    x_.setZero();
+    P_.setZero();
+    for (int a = 0; a < 3; ++a) {
+      const int p = Model::position_index(a), v = Model::velocity_index(a);
+      x_(p) = z(a);
+      for (int b = 0; b < 3; ++b) P_(p, Model::position_index(b)) = R(a, b);
+      if (!(planar && a == 2)) P_(v, v) = velocity_sigma * velocity_sigma;
+      if constexpr (Model::kOrder == 3)
+        if (!(planar && a == 2)) P_(a * 3 + 2, a * 3 + 2) = s_.sa0 * s_.sa0;
+    }
+    planar_ = planar;
+    has_first_ = false;
+    independent_axes_ = diagonal(R);
+    return true;
+  }
+
   void fill(Estimate& e) const override { set_estimate_state(e, x_, P_, kEnuIndex); }
 
  private:

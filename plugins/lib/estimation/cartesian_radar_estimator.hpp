@@ -86,6 +86,10 @@ class CartesianRadarEstimator : public Estimator, protected CartesianRadarState<
   void end_run(bool) override { derived().on_end_run_report(); }
   void predict(double T) override { this->predict_state(T, same_interval(T, this->last_interval())); }
   bool initiate(const Measurement& m, int) override { return this->add_point(m, R_); }
+  bool starts_from_one_point() const override { return true; }
+  bool initiate_one_point(const Measurement& m, int, double velocity_sigma) override {
+    return this->start_at_rest(m, R_, velocity_sigma);
+  }
   void fill(Estimate& e) const override { this->fill_state(e); }
   bool assign(const StateVec& x, const StateCov& P) override {
     if (x.size() != N || P.rows() != N || P.cols() != N) return false;

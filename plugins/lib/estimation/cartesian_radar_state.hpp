@@ -175,6 +175,26 @@ class CartesianRadarState {
     ++points_;
     return form_state();
   }
+  // One-point start: the converted point (position, covariance J R J' as add_point's) with velocity
+  // 0 of variance velocity_sigma^2 per axis (none on z for a 2-D radar's point, whose track lies in
+  // its plane), CA/Singer acceleration 0 with initial_sigma_acceleration.
+  bool start_at_rest(const Measurement& m, const MeasCov& R, double velocity_sigma) {
+    planar_ = m.frame == Frame::Polar;
+    points_ = 0;
+    const Vec3 z = measured_position(m);
+    Mat3 Rc = measured_position_covariance(m, R);
+    Rc = 0.5 * (Rc + Rc.transpose());
+    x_.setZero();
+    P_.setZero();
+    for (int a = 0; a < 3; ++a) {
+      x_(idx_[a]) = z(a);
+      for (int b = 0; b < 3; ++b) P_(idx_[a], idx_[b]) = Rc(a, b);
+      if (!(planar_ && a == 2)) P_(idx_[a + 3], idx_[a + 3]) = velocity_sigma * velocity_sigma;
+      if constexpr (Order == 3)
+        if (!(planar_ && a == 2)) P_(a * 3 + 2, a * 3 + 2) = s_.sa0 * s_.sa0;
+    }
+    return true;
+  }
   bool form_state() {
     const bool three = s_.init == Settings::Init::Paper000 && Order == 3;
     if (points_ < (three ? 3 : 2)) return false;

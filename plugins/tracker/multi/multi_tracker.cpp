@@ -346,13 +346,26 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
       t.predicted = PredictedMeasurement{};
       t.can_predict = false;
       if (t.adapters) t.adapters->start_track(ctx_);
-      t.time = st.first.time;
-      const int dim1 = dimension(st.first, st.first);
-      set_R(*t.estimator, st.first, dim1);
-      if (t.adapters) t.adapters->before_update(st.first, dim1);
-      bool formed = t.estimator->initiate(st.first, dim1);
-      if (t.adapters) after_update(t, st.first, st.first.time, formed);
-      if (!formed) {
+      const bool one_point = st.velocity_sigma > 0.0;
+      bool formed = false;
+      if (one_point) {  // the current detection alone, at rest with the initiator's velocity prior
+        const Detection& d = s.detections[static_cast<size_t>(st.second)];
+        to_measurement(s, d, m_);
+        t.time = s.time;
+        const int dim = dimension(s.sensor, d);
+        set_R(*t.estimator, d, dim);
+        if (t.adapters) t.adapters->before_update(m_, dim);
+        formed = t.estimator->initiate_one_point(m_, dim, st.velocity_sigma);
+        if (t.adapters) after_update(t, m_, s.time, formed);
+      } else {
+        t.time = st.first.time;
+        const int dim1 = dimension(st.first, st.first);
+        set_R(*t.estimator, st.first, dim1);
+        if (t.adapters) t.adapters->before_update(st.first, dim1);
+        formed = t.estimator->initiate(st.first, dim1);
+        if (t.adapters) after_update(t, st.first, st.first.time, formed);
+      }
+      if (!formed && !one_point) {
         const Detection& d = s.detections[static_cast<size_t>(st.second)];
         to_measurement(s, d, m_);
         t.time = s.time;
@@ -372,16 +385,15 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
       ++run_.started;
       t.published.id = next_id_++;
       t.published.status = TrackStatus::Tentative;
-      t.published.hits = 2;
+      t.published.hits = one_point ? 1 : 2;
       t.published.misses = 0;
       t.published.score = st.score;
       t.peak_score = st.score;
-      t.looks = 2;
-      t.history = 0b11;
+      t.looks = one_point ? 1 : 2;
+      t.history = one_point ? 0b1 : 0b11;
       t.last_time = s.time;
-      t.published.estimate.target = st.first.origin == s.detections[static_cast<size_t>(st.second)].origin
-                                        ? st.first.origin
-                                        : kOriginUnknown;
+      const std::uint32_t origin = s.detections[static_cast<size_t>(st.second)].origin;
+      t.published.estimate.target = one_point || st.first.origin == origin ? origin : kOriginUnknown;
     }
   }
 
@@ -507,6 +519,11 @@ std::unique_ptr<Component> create(const Params& p) {
   std::unique_ptr<Estimator> estimator = estimator_entry.create_estimator();
   auto associator = make_part<Associator>(p.component("associator"), "an associator");
   auto initiator = make_part<Initiator>(p.component("initiator"), "an initiator");
+  if (initiator->one_point_starts() && !estimator->starts_from_one_point())
+    throw ConfigError("the initiator " + p.component("initiator").type + " starts tracks from one point, which " +
+                          estimator_entry.type + " cannot (it offers no Estimator::initiate_one_point): start "
+                          "tracks from two points, or take an estimator that starts from one",
+                      estimator_entry.type_where, p.node());
   auto deleter = make_part<Deleter>(p.component("deleter"), "a deleter");
   return std::make_unique<MultiTracker>(p.node(), std::move(estimator), p.components("adapters"), std::move(associator),
                                         std::move(initiator), std::move(deleter),

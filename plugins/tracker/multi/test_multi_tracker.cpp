@@ -393,3 +393,53 @@ TEST_CASE("per-track adapters the estimator cannot serve") {
                                "deleter: { type: delete.misses } }"),
                     Catch::Contains("filter.kalman"));
 }
+
+// init.m_of_n start: one_point — a detection no track took starts a tentative track at once, at rest
+// with the velocity prior: both targets are tentative after the first scan (one hit each, zero
+// velocity, velocity variance max_speed^2 / 4), confirmed at the third scan with 3 hits of 3 looks
+// (a scan earlier than two-point), and followed to the end.
+TEST_CASE("one-point starts: tentative at once and confirmed") {
+  auto n = test::make("tracker.multi",
+                      "{ estimator: { type: filter.kalman, q: 0.1 m2/s3 }, associator: { type: assoc.gnn }, initiator: "
+                      "{ type: init.m_of_n, m: 3, n: 4, max_speed: 50 m/s, start: one_point }, deleter: { type: "
+                      "delete.misses, max_misses: 3 } }");
+  SetCollector out;
+  out.attach_to(*n);
+  test::start_run(*n);
+  Scenario sc;
+  for (int k = 0; k < 12; ++k) n->on_scan(sc.scan_at(k, 0), 0);
+  REQUIRE(out.sets.size() == 12);
+  REQUIRE(out.sets[0].tracks.size() == 2);
+  for (const TrackEstimate& t : out.sets[0].tracks) {
+    CHECK(t.status == TrackStatus::Tentative);
+    CHECK(t.hits == 1);
+    CHECK(t.estimate.enu.tail<3>().isZero());
+    CHECK(t.estimate.enu_covariance(3, 3) == Approx(25.0 * 25.0));
+    CHECK(t.estimate.enu_covariance(0, 3) == 0.0);  // no position-velocity cross term
+  }
+  CHECK(confirmed(out.sets[1]).empty());
+  REQUIRE(confirmed(out.sets[2]).size() == 2);
+  for (size_t k = 2; k < out.sets.size(); ++k) {
+    REQUIRE(confirmed(out.sets[k]).size() == 2);
+    for (const TrackEstimate* t : confirmed(out.sets[k])) CHECK((t->estimate.target == 1 || t->estimate.target == 2));
+  }
+  // The velocity is learnt: 10 m/s along y at the end, within a few sigma.
+  for (const TrackEstimate* t : confirmed(out.sets.back())) CHECK(std::fabs(std::fabs(t->estimate.enu(4)) - 10.0) < 1.5);
+}
+
+// One-point starts need an estimator that offers them: filter.imm is refused at its type line;
+// a velocity_sigma with two-point starts is refused at its own line.
+TEST_CASE("one-point starts refused where they cannot be") {
+  try {
+    (void)test::make("tracker.multi",
+                     "{ estimator: { type: filter.imm, modes: [{ motion: constant_velocity }, { motion: "
+                     "constant_acceleration }], transition: [0.9, 0.1, 0.1, 0.9] }, associator: { type: assoc.gnn }, "
+                     "initiator: { type: init.m_of_n, max_speed: 50 m/s, start: one_point }, deleter: { type: "
+                     "delete.misses } }");
+    FAIL("filter.imm with one-point starts was accepted");
+  } catch (const ConfigError& e) {
+    CHECK_THAT(std::string(e.what()), Catch::Contains("starts tracks from one point, which filter.imm cannot"));
+  }
+  CHECK_THROWS_WITH(test::make_part<Initiator>("init.m_of_n", "{ max_speed: 50 m/s, velocity_sigma: 10 m/s }"),
+                    Catch::Contains("velocity_sigma") && Catch::Contains("one_point"));
+}
