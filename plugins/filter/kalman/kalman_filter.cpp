@@ -126,11 +126,7 @@ class KalmanEstimator final : public Estimator {
   bool initiate(const Measurement& m, int) override {
     const bool planar = m.frame == Frame::Planar;
     const Vec3 z = measured_position(m);
-    Mat3 R = Mat3::Zero();
-    if (planar)
-      R.topLeftCorner<2, 2>() = R_.topLeftCorner(2, 2);
-    else
-      R = R_.topLeftCorner(3, 3);
+    const Mat3 R = measured_position_covariance(m, R_);  // a planar point: zero z row and column
     if (has_first_ && planar != first_planar_) has_first_ = false;  // a planar and a 3-D point do not pair
     const double T = m.time - t1_;
     if (!has_first_ || T <= 0.0) {
@@ -170,11 +166,7 @@ class KalmanEstimator final : public Estimator {
   bool initiate_one_point(const Measurement& m, int, double velocity_sigma) override {
     const bool planar = m.frame == Frame::Planar;
     const Vec3 z = measured_position(m);
-    Mat3 R = Mat3::Zero();
-    if (planar)
-      R.topLeftCorner<2, 2>() = R_.topLeftCorner(2, 2);
-    else
-      R = R_.topLeftCorner(3, 3);
+    const Mat3 R = measured_position_covariance(m, R_);  // a planar point: zero z row and column
     x_.setZero();
     P_.setZero();
     for (int a = 0; a < 3; ++a) {
