@@ -1,6 +1,6 @@
 // Purpose: benchmark: tracker.multi (assoc.gnn + init.m_of_n + delete.misses, a CV filter.kalman per track; filter.ekf on spherical plots) scans per second on Stone Soup's k-d-tree tutorial scenario, a 1000-target case in Cartesian and in spherical scans, heap allocations per scan, and sink.gospa steps per second.
 //
-// Usage: trackflow-bench-tracker [--runs N] [--rounds R] [--plugins DIR] [--case kdtree|adapted|scale|spherical|gospa|all]
+// Usage: trackflow-bench-tracker [--runs N] [--rounds R] [--plugins DIR] [--case kdtree|adapted|jpda|jpda_lbp|scale|spherical|gospa|all]
 //                                [--targets N]
 // Single thread, CPU time of the process (and wall time). The scans of every run are made first by
 // sim.scenario (not timed) and stored; each round then feeds them to a fresh tracker.multi, run by
@@ -19,6 +19,9 @@
 //           R = 0.25 I m2, scans every 5 s, 30 scans a run (about 55 targets alive on average, ~100
 //           detections per scan; docs/performance.md gives the peer's figures on this machine).
 //   adapted the kdtree case with adapt.innovation_r on every track (tracker.multi `adapters:`).
+//   jpda    the kdtree case under assoc.jpda (exact per cluster up to 10 000 joint events, else loopy
+//           belief propagation) with score deletion (a JPDA track rarely misses: some clutter is in its gate).
+//   jpda_lbp  the same with belief propagation on every cluster (max_events: 1), as Stone Soup's JPDAwithLBP.
 //   scale   1000 targets that live throughout and 1000 clutter detections per scan over 3 km x 3 km.
 //   spherical  the scale case's targets seen by sim.scan_radar at the centre of the region (30 m below
 //           it): [range, azimuth, elevation] plots, sigmas 0.5 m and 0.3 mrad, P_D 0.9, 1000 clutter
@@ -237,6 +240,20 @@ const char* kAdaptedTracker =
     "  initiator: { type: init.m_of_n, m: 3, n: 4, max_speed: 10 m/s },"
     "  deleter: { type: delete.misses, max_misses: 3 } }";
 
+// The kdtree tracker under JPDA (assoc.jpda: each cluster exact up to max_events joint events, loopy
+// belief propagation above) and the combined update per track (issue 22). `lbp` forces belief
+// propagation on every cluster (max_events: 1): the case of Stone Soup's JPDAwithLBP.
+const char* kJpdaTracker =
+    "{ estimator: { type: filter.kalman, motion: constant_velocity, q: 0.005 m2/s3 },"
+    "  associator: { type: assoc.jpda, gate_probability: 0.99 },"
+    "  initiator: { type: init.m_of_n, m: 3, n: 4, max_speed: 10 m/s },"
+    "  deleter: { type: delete.score, score_drop: 6.5, max_position_sd: 10 m } }";
+const char* kJpdaLbpTracker =
+    "{ estimator: { type: filter.kalman, motion: constant_velocity, q: 0.005 m2/s3 },"
+    "  associator: { type: assoc.jpda, gate_probability: 0.99, max_events: 1 },"
+    "  initiator: { type: init.m_of_n, m: 3, n: 4, max_speed: 10 m/s },"
+    "  deleter: { type: delete.score, score_drop: 6.5, max_position_sd: 10 m } }";
+
 void run_tracker_case(const host::PluginRegistry& reg, const char* name, const std::string& scenario, int runs,
                       int rounds, int warm_up, const char* tracker = kTracker, const std::string& radar = "") {
   double dets = 0, alive = 0;
@@ -310,7 +327,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--targets")) spherical_targets = std::max(1, std::atoi(argv[i + 1]));
     else {
       std::fprintf(stderr, "unknown option %s; usage: trackflow-bench-tracker [--runs N] [--rounds R] [--plugins DIR] "
-                   "[--case kdtree|adapted|scale|spherical|gospa|all] [--targets N (spherical)]\n", argv[i]);
+                   "[--case kdtree|adapted|jpda|jpda_lbp|scale|spherical|gospa|all] [--targets N (spherical)]\n", argv[i]);
       return 2;
     }
   }
@@ -328,6 +345,9 @@ int main(int argc, char** argv) {
   // The kdtree case with per-track adapt.innovation_r (tracker.multi `adapters:`).
   if (which == "all" || which == "adapted")
     run_tracker_case(reg, "adapted", kdtree_scenario, runs, rounds, 4, kAdaptedTracker);
+  if (which == "all" || which == "jpda") run_tracker_case(reg, "jpda", kdtree_scenario, runs, rounds, 4, kJpdaTracker);
+  if (which == "all" || which == "jpda_lbp")
+    run_tracker_case(reg, "jpda_lbp", kdtree_scenario, runs, rounds, 4, kJpdaLbpTracker);
   if (which == "all" || which == "scale")
     run_tracker_case(reg, "scale",
                      "{ period: 5 s, duration: 145 s, planar: true, region_lo: [-1500 m, -1500 m], region_hi: [1500 m, 1500 m],"

@@ -4,6 +4,7 @@
 #include <trackflow/single_track_filter.hpp>
 
 #include <Eigen/Cholesky>
+#include <Eigen/Eigenvalues>
 #include <catch2/catch.hpp>
 
 #include "plugin_fixture.hpp"
@@ -329,5 +330,134 @@ TEST_CASE("one-point starts: at rest with the velocity prior") {
     }
     const Mat3 Rp = measured_position_covariance(m, m.covariance);
     CHECK((x.enu_covariance.topLeftCorner<3, 3>() - Rp).norm() < 1e-9 * Rp.norm());
+  }
+}
+
+// The combined update of probabilistic association (Estimator::update_weighted): the moment-matched
+// mixture of the prediction and of each candidate's own update, checked against clones updated one
+// detection each and, for filter.kalman, against the textbook PDA equations with H written out
+// (Bar-Shalom, Willett & Tian 2011, eq. 3.4.2-1 to 3.4.2-4).
+TEST_CASE("weighted updates: the moment-matched mixture of the candidates' updates") {
+  int covered = 0;
+  for (const Case& c : cases()) {
+    auto e = test::fixture().make_estimator(c.type, c.params);
+    if (!e->takes_weighted_updates()) continue;
+    ++covered;
+    INFO(c.type << " " << c.params << " " << to_string(c.frame));
+    const auto ms = track(c.frame, 40);
+    Track t;
+    run(*e, t, std::vector<Measurement>(ms.begin(), ms.begin() + 30), [](const Measurement&) {},
+        [](const Measurement&, bool) {});
+    const Measurement& next = ms[30];
+    t.time = next.time;
+    e->predict(next.time - ms[29].time);
+    // Three candidates around the next measurement (a few sigma apart), and their probabilities.
+    std::vector<Measurement> cand(3, next);
+    const int dim = static_cast<int>(next.value.size());
+    for (int k = 0; k < 3; ++k)
+      for (int a = 0; a < dim; ++a) cand[static_cast<size_t>(k)].value(a) += (k - 1) * 2.0 * std::sqrt(next.covariance(a, a)) * (a % 2 ? -1 : 1);
+    const std::vector<double> p = {0.3, 0.45, 0.15};
+    const double none = 0.1;
+    Estimate predicted;
+    e->fill(predicted);
+    // Independent: each candidate's update on its own clone, mixed here.
+    const int n = static_cast<int>(predicted.state.size());
+    Eigen::VectorXd mean = none * Eigen::VectorXd(predicted.state);
+    std::vector<Eigen::VectorXd> xs;
+    std::vector<Eigen::MatrixXd> Ps;
+    for (int k = 0; k < 3; ++k) {
+      auto one = e->clone();
+      Track tk;
+      tk.time = t.time;
+      tk.estimate = &tk.e;
+      one->bind(tk);
+      one->measurement_noise() = next.covariance;
+      REQUIRE(one->update(cand[static_cast<size_t>(k)], dim));
+      Estimate u;
+      one->fill(u);
+      xs.emplace_back(u.state);
+      Ps.emplace_back(u.covariance);
+      mean += p[static_cast<size_t>(k)] * xs.back();
+    }
+    Eigen::MatrixXd cov = none * (Eigen::MatrixXd(predicted.covariance) +
+                                  (Eigen::VectorXd(predicted.state) - mean) * (Eigen::VectorXd(predicted.state) - mean).transpose());
+    for (int k = 0; k < 3; ++k)
+      cov += p[static_cast<size_t>(k)] * (Ps[static_cast<size_t>(k)] + (xs[static_cast<size_t>(k)] - mean) * (xs[static_cast<size_t>(k)] - mean).transpose());
+    t.e.updated = false;
+    REQUIRE(e->update_weighted(cand, p, none, dim));
+    Estimate mixed;
+    e->fill(mixed);
+    for (int i = 0; i < n; ++i) {
+      CHECK(mixed.state(i) == Approx(mean(i)).epsilon(1e-10).margin(1e-9));
+      for (int j = 0; j < n; ++j) CHECK(mixed.covariance(i, j) == Approx(cov(i, j)).epsilon(1e-9).margin(1e-9));
+    }
+    CHECK((mixed.covariance - mixed.covariance.transpose()).cwiseAbs().maxCoeff() == 0.0);
+    // PSD (a planar track's z rows are zero: semi-definite).
+    CHECK(Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd>(Eigen::MatrixXd(mixed.covariance)).eigenvalues().minCoeff() >= -1e-9 * mixed.covariance.norm());
+    CHECK(t.e.updated);  // the combined innovation is published
+    CHECK(t.e.innovation.size() == dim);
+
+    if (c.type == "filter.kalman" && c.frame == Frame::Cartesian && c.params == "{q: 1 m2/s3}") {
+      // The textbook PDA with H selecting [x y z] of [x vx y vy z vz]: x = x^ + K nu_bar,
+      // P = b0 P^ + (1 - b0) (P^ - K S K') + K (sum b nu nu' - nu_bar nu_bar') K'.
+      Eigen::MatrixXd H = Eigen::MatrixXd::Zero(3, n);
+      for (int a = 0; a < 3; ++a) H(a, 2 * a) = 1.0;
+      const Eigen::MatrixXd P0 = predicted.covariance;
+      const Eigen::VectorXd x0 = predicted.state;
+      const Eigen::MatrixXd S = H * P0 * H.transpose() + Eigen::MatrixXd(next.covariance);
+      const Eigen::MatrixXd K = P0 * H.transpose() * S.inverse();
+      Eigen::VectorXd nu_bar = Eigen::VectorXd::Zero(3);
+      Eigen::MatrixXd spread = Eigen::MatrixXd::Zero(3, 3);
+      for (int k = 0; k < 3; ++k) {
+        const Eigen::VectorXd nu = Eigen::VectorXd(cand[static_cast<size_t>(k)].value) - H * x0;
+        nu_bar += p[static_cast<size_t>(k)] * nu;
+        spread += p[static_cast<size_t>(k)] * nu * nu.transpose();
+      }
+      spread -= nu_bar * nu_bar.transpose();
+      const Eigen::VectorXd x = x0 + K * nu_bar;
+      const Eigen::MatrixXd P = none * P0 + (1.0 - none) * (P0 - K * S * K.transpose()) + K * spread * K.transpose();
+      for (int i = 0; i < n; ++i) {
+        CHECK(mixed.state(i) == Approx(x(i)).epsilon(1e-10).margin(1e-9));
+        for (int j = 0; j < n; ++j) CHECK(mixed.covariance(i, j) == Approx(P(i, j)).epsilon(1e-8).margin(1e-8));
+      }
+      for (int a = 0; a < 3; ++a) CHECK(t.e.innovation(a) == Approx(nu_bar(a)).epsilon(1e-10).margin(1e-10));
+    }
+  }
+  CHECK(covered >= 5);  // kalman (CV, CA, planar), ekf (spherical, CA, polar), ukf
+}
+
+TEST_CASE("weighted updates: one sure detection is the plain update; none used changes nothing") {
+  for (const Case& c : cases()) {
+    auto e = test::fixture().make_estimator(c.type, c.params);
+    if (!e->takes_weighted_updates()) continue;
+    INFO(c.type << " " << c.params);
+    const auto ms = track(c.frame, 35);
+    Track t;
+    run(*e, t, std::vector<Measurement>(ms.begin(), ms.begin() + 30), [](const Measurement&) {},
+        [](const Measurement&, bool) {});
+    t.time = ms[30].time;
+    e->predict(ms[30].time - ms[29].time);
+    auto plain = e->clone();
+    Track tp;
+    tp.time = t.time;
+    tp.estimate = &tp.e;
+    plain->bind(tp);
+    const int dim = static_cast<int>(ms[30].value.size());
+    plain->measurement_noise() = ms[30].covariance;
+    REQUIRE(plain->update(ms[30], dim));
+    const std::vector<Measurement> one = {ms[30]};
+    REQUIRE(e->update_weighted(one, std::vector<double>{1.0}, 0.0, dim));
+    Estimate a, b;
+    e->fill(a);
+    plain->fill(b);
+    for (int i = 0; i < a.state.size(); ++i) CHECK(a.state(i) == Approx(b.state(i)).epsilon(1e-12).margin(1e-9));
+    CHECK(t.e.nis == Approx(tp.e.nis).epsilon(1e-9));
+    // Probability 0 for the only candidate: nothing used, the state is the prediction.
+    Estimate before, after;
+    e->predict(0.1);
+    e->fill(before);
+    CHECK_FALSE(e->update_weighted(one, std::vector<double>{0.0}, 1.0, dim));
+    e->fill(after);
+    CHECK(after.state == before.state);
   }
 }

@@ -14,6 +14,7 @@
 #include <cstdint>
 #include <limits>
 #include <memory>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -130,6 +131,24 @@ class Estimator {
   virtual bool starts_from_one_point() const { return false; }
   virtual bool initiate_one_point(const Measurement& /*m*/, int /*dim*/, double /*velocity_sigma*/) { return false; }
 
+  // Optional: the combined update of probabilistic data association (PDA, JPDA): detections[k] is
+  // this track's with probability probability[k], none of them with probability `none` (the sum
+  // is 1; each detection valid, of this estimator's frame and of dimension dim). The posterior is the
+  // mixture of the predicted state (weight `none`) and of the updates with each detection, matched
+  // in its first two moments (Bar-Shalom, Willett & Tian 2011, "Tracking and Data Fusion", eq.
+  // 3.4.2-1 to 3.4.2-4 for the PDA; for an update whose gain does not depend on z — Kalman, EKF
+  // linearised at the prediction, UKF — that mixture is exactly the PDA's x = x^ + K nu_bar,
+  // P = none P^ + (1 - none) P_upd + K (sum_k b_k nu_k nu_k' - nu_bar nu_bar') K'). The default,
+  // combined_by_moments, runs update() per detection from the predicted state (restored by assign())
+  // and combines; an estimator that can take it says so in takes_weighted_updates(), and one with
+  // modes of its own (an IMM) overrides update_weighted. false: no detection could be used (the
+  // state is the prediction; warn() why).
+  virtual bool takes_weighted_updates() const { return false; }
+  virtual bool update_weighted(std::span<const Measurement> detections, std::span<const double> probability, double none,
+                               int dim) {
+    return combined_by_moments(detections, probability, none, dim);
+  }
+
   const MeasurementSpec& measurement_spec() const { return spec_; }
   void bind(TrackContext& track) { track_ = &track; }
   MeasCov& measurement_noise() { return R_; }
@@ -201,6 +220,73 @@ class Estimator {
     wrap_residual(s.frame, p.z);
     p.S = innovation.innovation_covariance;
     return set_log_det(p);
+  }
+
+  // The moment-matched mixture of update_weighted through this estimator's own update() and
+  // assign(): from the predicted x^, P^ (fill()), each detection k with probability b_k > 0 gives
+  // x_k, P_k (update, fill, then assign(x^, P^) back); the posterior is
+  //   x = x^ + d,  d = sum_k b_k (x_k - x^),  P = none P^ + sum_k b_k (P_k + (x_k - x^)(x_k - x^)') - d d'
+  // (deviations from x^, so the sums do not cancel), symmetrised. A detection the update refuses
+  // loses its weight (the rest renormalised). The published innovation is nu_bar = sum_k b_k nu_k
+  // with the first used detection's S, NIS = nu_bar' S^-1 nu_bar. Stack storage only (StateVec,
+  // StateCov are bounded): nothing is allocated.
+  bool combined_by_moments(std::span<const Measurement> detections, std::span<const double> probability, double none,
+                           int dim) {
+    Estimate predicted, updated;
+    fill(predicted);
+    const StateVec x0 = predicted.state;
+    const StateCov P0 = predicted.covariance;
+    const int n = static_cast<int>(x0.size());
+    StateVec d = StateVec::Zero(n);
+    StateCov M = StateCov::Zero(n, n);
+    double weight = 0.0;
+    MeasVec nu_bar;
+    MeasCov S;
+    bool have_innovation = false;
+    Estimate* published = track_ ? track_->estimate : nullptr;
+    for (std::size_t k = 0; k < detections.size() && k < probability.size(); ++k) {
+      const double b = probability[k];
+      if (!(b > 0.0)) continue;
+      if (weight > 0.0 && !assign(x0, P0)) return false;  // the predicted state again (takes_weighted_updates: it can)
+      R_ = detections[k].covariance.topLeftCorner(dim, dim);
+      if (published) published->updated = false;
+      if (!update(detections[k], dim)) continue;
+      fill(updated);
+      const StateVec dx = updated.state - x0;
+      d += b * dx;
+      M += b * (updated.covariance + dx * dx.transpose());
+      weight += b;
+      if (published && published->updated && published->innovation.size() == dim) {
+        if (!have_innovation) {
+          nu_bar = MeasVec::Zero(dim);
+          S = published->innovation_covariance;
+          have_innovation = true;
+        }
+        nu_bar += b * published->innovation;
+      }
+    }
+    if (!(weight > 0.0)) {
+      if (published) published->updated = false;
+      return false;  // nothing used: the state stays the prediction (assign restored it, or no update ran)
+    }
+    // Renormalised over what was used: none keeps its share of the total.
+    const double total = none + weight;
+    d /= total;
+    M /= total;
+    nu_bar /= total;
+    const double w0 = none / total;
+    StateCov P = w0 * P0 + M - d * d.transpose();
+    P = 0.5 * (P + P.transpose());
+    const StateVec x = x0 + d;
+    if (!assign(x, P)) return false;
+    if (published && have_innovation) {
+      published->updated = true;
+      published->innovation = nu_bar;
+      published->innovation_covariance = S;
+      const Eigen::LLT<MeasCov> llt(S);
+      published->nis = llt.info() == Eigen::Success ? llt.matrixL().solve(nu_bar).squaredNorm() : 0.0;
+    }
+    return true;
   }
 
   MeasCov R_;  // this update's measurement noise, exposed to adapters through noise()

@@ -11,8 +11,10 @@
 
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <memory>
 #include <span>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
@@ -35,6 +37,10 @@ struct TrackView {
   // so far. It starts at TrackStart::score; NaN when a scan did not state P_D or its clutter density.
   double score = 0.0;
   double peak_score = 0.0;
+  // The probability that the track is a target (JIPDA's existence, Musicki & Evans 2004), as the
+  // associator last gave it; NaN when the tracker keeps none (hard association, assoc.pda/jpda
+  // without survival_probability). init.existence and delete.existence read it.
+  double existence = std::numeric_limits<double>::quiet_NaN();
 };
 
 // The track score's increment per look (Blackman & Popoli 1999, "Design and Analysis of Modern
@@ -60,15 +66,90 @@ inline double miss(double detection_probability, double gate_probability = 1.0) 
 class BOOST_SYMBOL_VISIBLE TrackerPart {
  public:
   virtual ~TrackerPart() = default;
+  // Whether the part reads TrackView::existence (init.existence, delete.existence): the tracker
+  // then refuses, before the run, an associator that keeps none.
+  virtual bool reads_existence() const { return false; }
 };
 
-// Data association: which detection of the scan each track takes.
+// The answer of a probabilistic associator (PDA, JPDA): for each track, the detections that may be
+// its own with their probabilities beta_ij, and the probability beta_i0 that none is (Bar-Shalom,
+// Willett & Tian 2011, "Tracking and Data Fusion", sec. 3.4 and 7.x: the association
+// probabilities). Entries are added track by track in the tracks' order; storage is kept between
+// scans, so a steady scan allocates nothing.
+class AssociationProbabilities {
+ public:
+  struct Entry {
+    int detection = 0;
+    double probability = 0.0;
+  };
+  // A new scan with `tracks` tracks, every track's none-probability 1 (no entries).
+  void clear(int tracks) {
+    entries_.clear();
+    first_.assign(static_cast<std::size_t>(tracks) + 1, 0);
+    none_.assign(static_cast<std::size_t>(tracks), 1.0);
+    existence_.assign(static_cast<std::size_t>(tracks), std::numeric_limits<double>::quiet_NaN());
+    last_ = 0;
+    initiation_threshold = 0.0;
+    exact_clusters = approximate_clusters = unconverged_clusters = 0;
+  }
+  // Track `track`'s entries: tracks in ascending order, each track's entries together.
+  void add(int track, int detection, double probability) {
+    if (track < last_ || track >= tracks())
+      throw std::logic_error("AssociationProbabilities::add: tracks out of order or out of range");
+    while (last_ < track) first_[static_cast<std::size_t>(++last_)] = static_cast<int>(entries_.size());
+    entries_.push_back({detection, probability});
+  }
+  void set_none(int track, double probability) { none_.at(static_cast<std::size_t>(track)) = probability; }
+  // An associator that keeps existence (JIPDA) gives each track's posterior existence
+  // probability; its entries and none() are then conditioned on the track existing.
+  void set_existence(int track, double probability) { existence_.at(static_cast<std::size_t>(track)) = probability; }
+  double existence(int track) const { return existence_[static_cast<std::size_t>(track)]; }
+
+  int tracks() const { return static_cast<int>(none_.size()); }
+  std::span<const Entry> of(int track) const {
+    const int size = static_cast<int>(entries_.size());
+    const int b = track <= last_ ? first_[static_cast<std::size_t>(track)] : size;
+    const int e = track < last_ ? first_[static_cast<std::size_t>(track) + 1] : size;
+    return std::span<const Entry>(entries_).subspan(static_cast<std::size_t>(b), static_cast<std::size_t>(e - b));
+  }
+  double none(int track) const { return none_[static_cast<std::size_t>(track)]; }
+
+  // A detection whose probability of being some track's (the sum over tracks) is at most this goes
+  // to the initiator; the others are the tracks'. 0 (the default): a detection in any track's gate
+  // starts no track (MATLAB's trackerJPDA InitializationThreshold, default 0).
+  double initiation_threshold = 0.0;
+  // How the probabilities were computed this look (JPDA: clusters of competing tracks by exact
+  // enumeration, by an approximation such as loopy belief propagation, and approximations that
+  // stopped before converging); the tracker sums them into its summary.
+  int exact_clusters = 0, approximate_clusters = 0, unconverged_clusters = 0;
+
+ private:
+  std::vector<Entry> entries_;
+  std::vector<int> first_;  // track t < last_: entries [first_[t], first_[t + 1]); last_: [first_[last_], end)
+  std::vector<double> none_, existence_;
+  int last_ = 0;
+};
+
+// Data association: which detection of the scan each track takes — one (associate), or, for a
+// probabilistic associator, each candidate with its probability (associate_probabilities).
 class BOOST_SYMBOL_VISIBLE Associator : public TrackerPart {
  public:
   // detection_of_track[i] (sized as tracks) receives the index in scan.detections given to
   // tracks[i], or -1; a detection goes to at most one track. The tracks come in a fixed order
   // (by id), so the answer is the same for any thread count.
   virtual void associate(std::span<const TrackView> tracks, const Scan& scan, std::span<int> detection_of_track) = 0;
+  // A probabilistic associator (assoc.pda, assoc.jpda) returns true and implements
+  // associate_probabilities; the tracker then calls it instead of associate() and updates each
+  // track with all its candidates at once (Estimator::update_weighted). `out` arrives cleared for
+  // tracks.size() tracks; each track's probabilities, with none(i), sum to 1. It is called for
+  // every look, also one without detections (existence decays through it).
+  virtual bool probabilistic() const { return false; }
+  // Whether it gives each track's existence (AssociationProbabilities::set_existence: JIPDA).
+  virtual bool keeps_existence() const { return false; }
+  virtual void associate_probabilities(std::span<const TrackView> /*tracks*/, const Scan& /*scan*/,
+                                       AssociationProbabilities& /*out*/) {
+    throw std::logic_error("this associator gives no association probabilities");
+  }
 };
 
 // A new track's first detections: `first` from an earlier scan (time first_time), `second` the
@@ -76,11 +157,13 @@ class BOOST_SYMBOL_VISIBLE Associator : public TrackerPart {
 // `score`: the track score L after the two (0: they are the reference the later looks add to).
 // velocity_sigma > 0: a one-point start — the detection `second` alone, at rest with velocity
 // standard deviation velocity_sigma per axis (Estimator::initiate_one_point; `first` is not used).
+// existence: the new track's existence probability (init.existence; NaN: none kept).
 struct TrackStart {
   Measurement first;
   int second = -1;
   double score = 0.0;
   double velocity_sigma = 0.0;
+  double existence = std::numeric_limits<double>::quiet_NaN();
 };
 
 // Track initiation and confirmation.

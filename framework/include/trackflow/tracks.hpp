@@ -4,6 +4,7 @@
 #include <trackflow/items.hpp>
 
 #include <cstdint>
+#include <limits>
 #include <span>
 
 namespace trackflow {
@@ -16,9 +17,11 @@ const char* to_string(TrackStatus s);
 struct TrackEstimate {
   std::uint64_t id = 0;  // unique within a run, never reused
   TrackStatus status = TrackStatus::Tentative;
-  // The tracker's confidence: an existence probability in [0, 1] or a log-likelihood-ratio score,
-  // as the tracker's declaration says; NaN when it keeps neither.
+  // The track score: tracker.multi's log-likelihood ratio of target against false alarms
+  // (tracker.hpp, track_score); NaN when the tracker keeps none.
   double score = 0.0;
+  // The probability that the track is a target (JIPDA); NaN when the tracker keeps none.
+  double existence = std::numeric_limits<double>::quiet_NaN();
   int hits = 0;    // detections used so far
   int misses = 0;  // consecutive looks without one
   Estimate estimate;

@@ -1,5 +1,6 @@
 // Purpose: assoc.gnn — global nearest neighbour: the one assignment of detections to tracks that maximises the joint likelihood ratio against misses and false alarms, inside chi-square gates, solved as a rectangular 2-D assignment (shortest augmenting path).
 #include "assignment/sparse_assignment.hpp"
+#include "association/assumed_sensor.hpp"
 #include "association/gated_pairs.hpp"
 
 #include <trackflow/chi_square.hpp>
@@ -15,13 +16,10 @@
 namespace trackflow {
 namespace {
 
-// What the associator assumes. P_D and the clutter density, when given, override the scan's own
-// (an analyst's model of the sensor: a mismatch study); NaN: the scan's, and P_D 0.9 if it is silent.
+// What the associator assumes: its gate, and P_D and the clutter density (association/assumed_sensor.hpp).
 struct GnnSettings {
   double gate_probability = 0.99;
-  double detection_probability = std::numeric_limits<double>::quiet_NaN();
-  double clutter_density = std::numeric_limits<double>::quiet_NaN();
-  std::string node;
+  association::AssumedSensor sensor;
 };
 
 // Cost of track i taking detection j, and of track i missing (Blackman & Popoli 1999, §6.2; Bar-Shalom,
@@ -32,21 +30,14 @@ struct GnnSettings {
 // "missed" column maximises the product of likelihood ratios of the joint hypothesis.
 // The matrix is n x (m + n): m detection columns, then one missed column per track (the others +inf),
 // held sparse (gated pairs only) and solved exactly per cluster of competing tracks.
-constexpr double kDefaultDetectionProbability = 0.9;
-
 class GnnAssociator final : public Associator {
  public:
   explicit GnnAssociator(GnnSettings s) : s_(std::move(s)) {}
 
   void associate(std::span<const TrackView> tracks, const Scan& scan, std::span<int> detection_of_track) override {
     const int n = static_cast<int>(tracks.size()), m = static_cast<int>(scan.detections.size());
-    const double pd = std::isfinite(s_.detection_probability) ? s_.detection_probability
-                      : std::isfinite(scan.detection_probability) ? scan.detection_probability
-                                                                   : kDefaultDetectionProbability;
-    const double lambda = std::isfinite(s_.clutter_density) ? s_.clutter_density : scan.clutter_density;
-    if (!(lambda > 0.0))
-      throw DataError("assoc.gnn (node '" + s_.node + "'): the scan at t=" + std::to_string(scan.time) +
-                      " s states no clutter density; give clutter_density");
+    const double pd = s_.sensor.detection_probability(scan);
+    const double lambda = s_.sensor.clutter_density(scan);
     const double log_lambda = std::log(lambda), log_pd = std::log(pd);
     const double missed = -std::log(1.0 - pd * s_.gate_probability);
     // Only gated pairs enter; the clustered solver splits the problem into the groups of tracks
@@ -67,10 +58,8 @@ class GnnAssociator final : public Associator {
 
 std::unique_ptr<TrackerPart> create_part(const Params& p) {
   GnnSettings s;
-  s.node = p.node();
   s.gate_probability = p.real("gate_probability");
-  s.detection_probability = p.real_or("detection_probability", std::numeric_limits<double>::quiet_NaN());
-  s.clutter_density = p.real_or("clutter_density", std::numeric_limits<double>::quiet_NaN());
+  s.sensor = association::AssumedSensor(p, "assoc.gnn (node '" + p.node() + "')");
   return std::make_unique<GnnAssociator>(s);
 }
 
@@ -94,13 +83,8 @@ void register_components(Registrar& r) {
       "track takes goes to the initiator. See docs/multi-target.md.";
   d.params = {
       association::gate_probability_param(),
-      ParamSpec::real("detection_probability", Dimension{},
-                      "assumed P_D (default: the scan's, else 0.9)")
-          .positive()
-          .at_most(1),
-      ParamSpec::real("clutter_density", Dimension{-3, 0, 0, 0},
-                      "assumed false detections per m3 of Cartesian measurement space (default: the scan's)")
-          .positive(),
+      association::AssumedSensor::detection_probability_param(),
+      association::AssumedSensor::clutter_density_param(),
   };
   d.create_part = create_part;
   r.add(std::move(d));

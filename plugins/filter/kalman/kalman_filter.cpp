@@ -184,6 +184,16 @@ class KalmanEstimator final : public Estimator {
   }
 
   void fill(Estimate& e) const override { set_estimate_state(e, x_, P_, kEnuIndex); }
+  // A state from outside (an IMM's mixed start, a PDA's combined posterior): it may couple the
+  // axes, so the per-axis shortcut is off until the next start.
+  bool assign(const StateVec& x, const StateCov& P) override {
+    if (x.size() != N || P.rows() != N || P.cols() != N) return false;
+    x_ = x.template head<N>();
+    P_ = P.template topLeftCorner<N, N>();
+    independent_axes_ = false;
+    return true;
+  }
+  bool takes_weighted_updates() const override { return true; }
 
  private:
 

@@ -97,6 +97,7 @@ class CartesianRadarEstimator : public Estimator, protected CartesianRadarState<
     P_ = P.template topLeftCorner<N, N>();
     return true;
   }
+  bool takes_weighted_updates() const override { return true; }
 
  protected:
   explicit CartesianRadarEstimator(Settings s)

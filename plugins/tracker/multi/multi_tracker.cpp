@@ -27,12 +27,14 @@ namespace {
 struct TrackerRunResult final : RunResult {
   std::uint64_t scans = 0, scans_not_looked = 0, scans_skipped = 0, detections = 0, updates = 0,
                 updates_refused = 0, started = 0, start_failed = 0, confirmed = 0, deleted = 0, deleted_non_finite = 0,
-                track_limit_refused = 0, confirmed_track_scans = 0, deleted_by_adapter = 0;
+                track_limit_refused = 0, confirmed_track_scans = 0, deleted_by_adapter = 0, weighted_updates = 0,
+                weighted_candidates = 0, exact_clusters = 0, approximate_clusters = 0, unconverged_clusters = 0;
   template <class Self, class F>
   static void fields(Self& r, F&& f) {
     f(r.scans, r.scans_not_looked, r.scans_skipped, r.detections, r.updates, r.updates_refused, r.started,
       r.start_failed, r.confirmed, r.deleted, r.deleted_non_finite, r.track_limit_refused, r.confirmed_track_scans,
-      r.deleted_by_adapter);
+      r.deleted_by_adapter, r.weighted_updates, r.weighted_candidates, r.exact_clusters,
+      r.approximate_clusters, r.unconverged_clusters);
   }
 };
 
@@ -68,6 +70,7 @@ struct Track final : TrackContext {
     v.history = history;
     v.score = published.score;
     v.peak_score = peak_score;
+    v.existence = published.existence;
     v.estimator = estimator.get();
     v.predicted = can_predict ? &predicted : nullptr;
     return v;
@@ -97,6 +100,7 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
         initiator_(std::move(initiator)),
         deleter_(std::move(deleter)),
         max_tracks_(max_tracks),
+        probabilistic_(associator_->probabilistic()),
         adapters_who_("tracker.multi (node '" + node_ + "', estimator " + estimator_type + ")") {
     // Refused now, at the offending entry's line, rather than at the first track: the adapters'
     // needs against the estimator's noise (each track's is a clone of the prototype's).
@@ -167,6 +171,17 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
     if (total_.scans_skipped) s.metric("scans_skipped", static_cast<double>(total_.scans_skipped));
     if (total_.deleted_non_finite) s.metric("deleted_non_finite", static_cast<double>(total_.deleted_non_finite));
     if (total_.deleted_by_adapter) s.metric("deleted_by_adapter", static_cast<double>(total_.deleted_by_adapter));
+    if (probabilistic_ && total_.exact_clusters + total_.approximate_clusters > 0) {
+      // How the associator computed its probabilities, per look (JPDA: exact or approximate per cluster).
+      const double scans = total_.scans ? static_cast<double>(total_.scans) : 1.0;
+      s.metric("exact_clusters_per_scan", static_cast<double>(total_.exact_clusters) / scans);
+      s.metric("approximate_clusters_per_scan", static_cast<double>(total_.approximate_clusters) / scans);
+      if (total_.unconverged_clusters) s.metric("unconverged_clusters", static_cast<double>(total_.unconverged_clusters));
+    }
+    if (probabilistic_)  // how many detections a combined update mixes, on average
+      s.metric("candidates_per_update", total_.weighted_updates ? static_cast<double>(total_.weighted_candidates) /
+                                                                       static_cast<double>(total_.weighted_updates)
+                                                                 : 0.0);
     if (total_.track_limit_refused) {
       s.metric("starts_refused_at_max_tracks", static_cast<double>(total_.track_limit_refused));
       s.notes.push_back(std::to_string(total_.track_limit_refused) + " track start(s) refused: max_tracks (" +
@@ -239,7 +254,9 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
   void associate(const Scan& s) {
     memory::assign_grown(assigned_, tracks_.size(), -1);
     memory::assign_grown(taken_, s.detections.size(), char{0});
-    if (tracks_.empty() || s.detections.empty()) return;
+    if (tracks_.empty()) return;
+    if (probabilistic_) return associate_probabilities(s);  // also without detections: existence decays
+    if (s.detections.empty()) return;
     associator_->associate(views_, s, assigned_);
     for (size_t i = 0; i < assigned_.size(); ++i) {
       const int j = assigned_[i];
@@ -252,7 +269,107 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
     }
   }
 
+  // A probabilistic associator's answer, checked (a part that breaks the contract is a bug): every
+  // candidate a detection of the scan, given to a track that can take one, with probabilities in
+  // [0, 1] summing with none to 1. A detection is the tracks' (not the initiator's) when its total
+  // probability exceeds the associator's initiation threshold.
+  void associate_probabilities(const Scan& s) {
+    const int n = static_cast<int>(tracks_.size()), m = static_cast<int>(s.detections.size());
+    probabilities_.clear(n);
+    associator_->associate_probabilities(views_, s, probabilities_);
+    run_.exact_clusters += static_cast<std::uint64_t>(std::max(0, probabilities_.exact_clusters));
+    run_.approximate_clusters += static_cast<std::uint64_t>(std::max(0, probabilities_.approximate_clusters));
+    run_.unconverged_clusters += static_cast<std::uint64_t>(std::max(0, probabilities_.unconverged_clusters));
+    memory::assign_grown(detection_share_, s.detections.size(), 0.0);
+    auto bug = [&](const std::string& what) {
+      return std::logic_error("tracker.multi (node '" + node_ + "'): the associator's probabilities " + what +
+                              " (a bug in that plugin)");
+    };
+    if (probabilities_.tracks() != n) throw bug("are for another number of tracks");
+    for (int i = 0; i < n; ++i) {
+      double sum = probabilities_.none(i);
+      if (!(sum >= 0.0 && sum <= 1.0)) throw bug("give track " + std::to_string(i) + " a none-probability outside [0, 1]");
+      for (const AssociationProbabilities::Entry& e : probabilities_.of(i)) {
+        if (e.detection < 0 || e.detection >= m || !views_[static_cast<size_t>(i)].predicted || !(e.probability >= 0.0) ||
+            !(e.probability <= 1.0))
+          throw bug("give detection " + std::to_string(e.detection) + " of " + std::to_string(m) + " to track " +
+                    std::to_string(i) + " with probability " + std::to_string(e.probability));
+        sum += e.probability;
+        detection_share_[static_cast<size_t>(e.detection)] += e.probability;
+      }
+      if (std::fabs(sum - 1.0) > 1e-9) throw bug("of track " + std::to_string(i) + " sum to " + std::to_string(sum));
+      const double r = probabilities_.existence(i);
+      if (!std::isnan(r)) {
+        if (!(r >= 0.0 && r <= 1.0)) throw bug("give track " + std::to_string(i) + " an existence of " + std::to_string(r));
+        tracks_[static_cast<size_t>(i)].published.existence = r;
+      }
+    }
+    for (int j = 0; j < m; ++j)
+      if (detection_share_[static_cast<size_t>(j)] > probabilities_.initiation_threshold) taken_[static_cast<size_t>(j)] = 1;
+  }
+
+  // Track i's combined update with its candidates (Estimator::update_weighted); the track score's
+  // increment of the look is that of the mixture: dL = ln(1 - P_D + P_D sum_j N(nu_j; 0, S) / beta_FA)
+  // over the candidates (IPDA's likelihood ratio, Musicki, Evans & Stankovic 1994, with P_G = 1 as
+  // for a hard association's miss), NaN when the scan states no P_D or clutter density.
+  bool update_weighted(Track& t, int i, const Scan& s) {
+    const std::span<const AssociationProbabilities::Entry> entries = probabilities_.of(i);
+    candidates_.clear();
+    candidate_probabilities_.clear();
+    int dim = -1;
+    double likelihood_sum = 0.0;
+    const bool gate = t.can_predict && gate_.set(t.predicted, s.sensor.frame);
+    for (const AssociationProbabilities::Entry& e : entries) {
+      if (!(e.probability > 0.0)) continue;
+      const Detection& d = s.detections[static_cast<size_t>(e.detection)];
+      const int k = dimension(s.sensor, d);
+      if (dim < 0) dim = k;
+      if (k != dim) continue;  // a detection without the range rate the others have: not mixed with them
+      candidates_.emplace_back();
+      to_measurement(s, d, candidates_.back());
+      candidate_probabilities_.push_back(e.probability);
+      if (gate) likelihood_sum += std::exp(gate_.log_likelihood(gate_.nis(d.value)));
+    }
+    const double pd = s.detection_probability, density = s.clutter_density;
+    double dL = std::numeric_limits<double>::quiet_NaN();
+    if (candidates_.empty()) {
+      if (pd >= 0.0 && pd <= 1.0) dL = track_score::miss(pd);
+    } else if (gate && pd > 0.0 && pd <= 1.0 && density > 0.0) {
+      dL = std::log(1.0 - pd + pd * likelihood_sum / density);
+    }
+    bool used = false;
+    if (!candidates_.empty()) {
+      used = t.estimator->update_weighted(candidates_, candidate_probabilities_, probabilities_.none(i), dim);
+      ++(used ? run_.updates : run_.updates_refused);
+      if (used) {
+        ++run_.weighted_updates;
+        run_.weighted_candidates += candidates_.size();
+      }
+    }
+    double& L = t.published.score;
+    L += dL;
+    t.peak_score = std::isnan(L) ? L : std::max(t.peak_score, L);
+    return used;
+  }
+
   void update(const Scan& s) {
+    if (probabilistic_) {
+      for (size_t i = 0; i < tracks_.size(); ++i) {
+        Track& t = tracks_[i];
+        ++t.looks;
+        clear_innovation(t.published.estimate);
+        const bool used = update_weighted(t, static_cast<int>(i), s);
+        t.history = (t.history << 1) | (used ? 1u : 0u);
+        if (used) {
+          ++t.published.hits;
+          t.published.misses = 0;
+        } else {
+          ++t.published.misses;
+        }
+        views_[i] = t.view();
+      }
+      return;
+    }
     for (size_t i = 0; i < tracks_.size(); ++i) {
       Track& t = tracks_[i];
       ++t.looks;
@@ -388,6 +505,7 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
       t.published.hits = one_point ? 1 : 2;
       t.published.misses = 0;
       t.published.score = st.score;
+      t.published.existence = st.existence;
       t.peak_score = st.score;
       t.looks = one_point ? 1 : 2;
       t.history = one_point ? 0b1 : 0b11;
@@ -494,6 +612,7 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
   std::unique_ptr<Initiator> initiator_;
   std::unique_ptr<Deleter> deleter_;
   int max_tracks_ = 0;
+  bool probabilistic_ = false;  // the associator gives probabilities: combined updates
   std::string adapters_who_;
   RunContext ctx_;  // this run's, for each new track's adapters
   Diagnostics* diag_ = nullptr;
@@ -503,6 +622,9 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
   std::vector<TrackView> views_;
   std::vector<int> assigned_, unassigned_;
   std::vector<char> taken_;
+  AssociationProbabilities probabilities_;
+  std::vector<double> detection_share_, candidate_probabilities_;
+  std::vector<Measurement> candidates_;
   std::vector<TrackStart> starts_;
   association::PredictedGate gate_;
   std::vector<TrackEstimate> set_;
@@ -525,6 +647,28 @@ std::unique_ptr<Component> create(const Params& p) {
                           "tracks from two points, or take an estimator that starts from one",
                       estimator_entry.type_where, p.node());
   auto deleter = make_part<Deleter>(p.component("deleter"), "a deleter");
+  const bool existence_read = initiator->reads_existence() || deleter->reads_existence();
+  if (existence_read && !associator->keeps_existence()) {
+    const bool by_initiator = initiator->reads_existence();
+    const char* part = by_initiator ? "initiator" : "deleter";
+    throw ConfigError("the " + std::string(part) + " " + p.component(part).type +
+                          " decides by each track's existence probability, which the associator " +
+                          p.component("associator").type +
+                          " does not keep: take assoc.jpda or assoc.pda with survival_probability (JIPDA, IPDA)",
+                      p.component(part).type_where, p.node());
+  }
+  if (associator->probabilistic()) {
+    if (!estimator->takes_weighted_updates())
+      throw ConfigError("the associator " + p.component("associator").type +
+                            " gives association probabilities, so each track is updated with all its candidate "
+                            "detections at once (Estimator::update_weighted), which " + estimator_entry.type +
+                            " cannot: take filter.kalman, filter.ekf, filter.ukf or filter.imm (with modes:)",
+                        estimator_entry.type_where, p.node());
+    if (!p.components("adapters").empty())
+      throw p.error("adapters", "per-track adapters see one detection per update; the associator " +
+                                    p.component("associator").type +
+                                    " updates a track with several at once (probabilistic association): not supported");
+  }
   return std::make_unique<MultiTracker>(p.node(), std::move(estimator), p.components("adapters"), std::move(associator),
                                         std::move(initiator), std::move(deleter),
                                         static_cast<int>(p.integer("max_tracks")), estimator_entry.type);
