@@ -1,7 +1,9 @@
-// Purpose: filter.imm — interacting multiple model filter: 2-4 Cartesian radar EKF modes (CV, CA, Singer, each with its own noise) mixed on the common Cartesian state, mode probabilities published as annotations.
+// Purpose: filter.imm — interacting multiple model filter: 2-4 Cartesian radar EKF modes (CV, CA, Singer, each with its own noise) mixed on the common Cartesian state, mode probabilities published as annotations; the IMM-PDA combined update under probabilistic association (imm_pda.hpp).
 #include "estimation/cartesian_radar_state.hpp"
 #include "estimation/ekf_radar_update.hpp"
 #include "imm_mixing.hpp"
+#include "imm_pda.hpp"
+#include "memory/grow.hpp"
 
 #include <trackflow/common_params.hpp>
 #include <trackflow/single_track_filter.hpp>
@@ -10,6 +12,7 @@
 #include <array>
 #include <cmath>
 #include <limits>
+#include <span>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -192,6 +195,105 @@ class ImmEstimator final : public Estimator {
     return true;
   }
 
+  // IMM-PDA (imm_pda.hpp): the mode-matched EKF update with each candidate from each mode's
+  // prediction, mixed per mode by moments with the weights w_jk, w_j0 and the new mu_j.
+  bool takes_weighted_updates() const override { return true; }
+  bool update_weighted(std::span<const Measurement> detections, std::span<const double> probability, double none,
+                       int dim) override {
+    return dim == 4 ? weighted_values<4>(detections, probability, none) : weighted_values<3>(detections, probability, none);
+  }
+
+  template <int M>
+  bool weighted_values(std::span<const Measurement> detections, std::span<const double> probability, double none) {
+    if (!mixed_) std::copy(mu_, mu_ + count_, c_);  // no time elapsed: no transition
+    imm::WeightedSums sums(count_);
+    imm::VecC dx[kMaxModes];  // candidate k's update of mode j, as a deviation from its prediction
+    imm::MatC Pk[kMaxModes];
+    double ll[kMaxModes];
+    bool used[kMaxModes];
+    bool dropped = false;
+    Eigen::Matrix<double, M, 1> nu_bar = Eigen::Matrix<double, M, 1>::Zero();
+    Eigen::Matrix<double, M, M> S_published = Eigen::Matrix<double, M, M>::Zero();
+    bool have_S = false;
+    for (std::size_t k = 0; k < detections.size() && k < probability.size(); ++k) {
+      const double b = probability[k];
+      if (!(b > 0.0)) continue;
+      const Measurement& m = detections[k];
+      const Eigen::Matrix<double, M, M> R = m.covariance.template topLeftCorner<M, M>();
+      for (int j = 0; j < count_; ++j) {
+        cartesian_filter::EkfOutcome outcome{};
+        visit(modes_[j], [&](auto& s) {
+          constexpr int N = 3 * order_of<decltype(s)>;
+          Eigen::Matrix<double, N, 1> x = s.x_;
+          Eigen::Matrix<double, N, N> P = s.P_;
+          outcome = cartesian_filter::ekf_radar_update<N, M>(x, P, s.idx_, m, R, uses_curvature(s), innovation<M>(j));
+          if (outcome == cartesian_filter::EkfOutcome::Used) {
+            dx[j].template head<N>() = x - s.x_;
+            Pk[j].template topLeftCorner<N, N>() = P;
+          } else {  // this mode keeps its prediction for this candidate, as update() does
+            dx[j].template head<N>().setZero();
+            Pk[j].template topLeftCorner<N, N>() = s.P_;
+          }
+        });
+        used[j] = outcome == cartesian_filter::EkfOutcome::Used;
+        dropped = dropped || innovation<M>(j).azimuth_dropped;
+        ll[j] = used[j] ? imm::log_likelihood(M, innovation<M>(j).nis, innovation<M>(j).det_S)
+                        : -std::numeric_limits<double>::infinity();
+        if (!used[j]) count(kModeRefused);
+      }
+      double q[kMaxModes];
+      if (!imm::candidate_mode_weights(c_, ll, used, count_, q)) continue;  // no mode could use it: dropped
+      for (int j = 0; j < count_; ++j)
+        visit(modes_[j], [&](auto& s) {
+          constexpr int N = 3 * order_of<decltype(s)>;
+          sums.add<N>(j, b * q[j], dx[j], Pk[j]);
+        });
+      sums.used += b;
+      Eigen::Matrix<double, M, 1> nu;
+      Eigen::Matrix<double, M, M> S;
+      innovation_of<M>(used, nu, S);
+      nu_bar += b * nu;
+      if (!have_S) S_published = S;
+      have_S = true;
+    }
+    if (dropped) count(kAzimuthDropped);
+    if (!(sums.used > 0.0)) {
+      warn("no mode could use any candidate detection at t=" + std::to_string(time()) +
+           " s (predicted position at the sensor, or S not positive definite); none used");
+      return false;  // nothing changed: the prediction, mode probabilities as before
+    }
+    const double total = none + sums.used;
+    for (int j = 0; j < count_; ++j) {
+      const double a = none * c_[j] + sums.W[j];  // total * mu_j
+      if (a > 0.0)
+        visit(modes_[j], [&](auto& s) {
+          constexpr int N = 3 * order_of<decltype(s)>;
+          imm::moment_step<N>(none * c_[j], sums, j, s.x_, s.P_);
+        });
+      mu_[j] = a / total;
+    }
+    imm::normalise(mu_, count_);
+    mixed_ = false;
+    publish_probabilities();
+    nu_bar /= total;
+    double nis = 0.0;
+    if (!imm::quadratic_form<M>(S_published, nu_bar, nis)) nis = 0.0;
+    accept_update<M>(nu_bar, S_published, nis);
+    return true;
+  }
+
+  // The measurement-prediction mixture of the last candidate's mode innovations.
+  template <int M>
+  void innovation_of(const bool* used, Eigen::Matrix<double, M, 1>& nu, Eigen::Matrix<double, M, M>& S) {
+    const Eigen::Matrix<double, M, 1>* nu_j[kMaxModes];
+    const Eigen::Matrix<double, M, M>* S_j[kMaxModes];
+    for (int j = 0; j < count_; ++j) {
+      nu_j[j] = &innovation<M>(j).nu;
+      S_j[j] = &innovation<M>(j).S;
+    }
+    imm::innovation_mixture<M>(c_, used, count_, nu_j, S_j, nu, S);
+  }
+
   // The measurement-prediction mixture (imm::innovation_mixture) as the accepted innovation.
   template <int M>
   void publish_innovation(const bool* used) {
@@ -326,7 +428,7 @@ class ComponentImmEstimator final : public Estimator {
     rebind();
   }
   ComponentImmEstimator(const ComponentImmEstimator& o)
-      : Estimator(o), count_(o.count_), any_acceleration_(o.any_acceleration_), st_(o.st_) {
+      : Estimator(o), count_(o.count_), any_acceleration_(o.any_acceleration_), mixed_(o.mixed_), st_(o.st_) {
     rebind();
   }
   ComponentImmEstimator& operator=(const ComponentImmEstimator&) = delete;
@@ -489,6 +591,133 @@ class ComponentImmEstimator final : public Estimator {
     return true;
   }
 
+  // IMM-PDA (imm_pda.hpp) over modes that take weighted updates: the weights w_jk from each mode's
+  // predicted measurement (its predict_measurement, reused while the candidates share the sensor
+  // and R), then each mode's own combined update (Estimator::update_weighted) with w_jk / mu_j and
+  // w_j0 / mu_j. A mode that cannot predict a candidate keeps its prediction for it: that weight
+  // joins its share of the prediction.
+  bool takes_weighted_updates() const override {
+    for (int j = 0; j < count_; ++j)
+      if (!mode(j).takes_weighted_updates()) return false;
+    return true;
+  }
+  bool update_weighted(std::span<const Measurement> detections, std::span<const double> probability, double none,
+                       int dim) override {
+    return dim == 4 ? weighted_values<4>(detections, probability, none) : weighted_values<3>(detections, probability, none);
+  }
+
+  static bool same_geometry(const Measurement& a, const Measurement& b, int dim) {
+    return a.sensor == b.sensor && a.frame == b.frame && a.azimuth == b.azimuth && a.sensor_level == b.sensor_level &&
+           a.sensor_position == b.sensor_position && a.sensor_axes == b.sensor_axes && a.time == b.time &&
+           a.has_range_rate == b.has_range_rate &&
+           a.covariance.topLeftCorner(dim, dim) == b.covariance.topLeftCorner(dim, dim);
+  }
+
+  template <int M>
+  bool weighted_values(std::span<const Measurement> detections, std::span<const double> probability, double none) {
+    using VecM = Eigen::Matrix<double, M, 1>;
+    using MatM = Eigen::Matrix<double, M, M>;
+    if (!mixed_)  // no time elapsed: no transition
+      for (int j = 0; j < count_; ++j) st_.c[j] = st_.mu[j];
+    const std::size_t n = std::min(detections.size(), probability.size());
+    memory::assign_grown(weights_, n * static_cast<std::size_t>(count_), 0.0);  // [j * n + k] = w_jk
+    double W[kMaxModes] = {}, kept[kMaxModes] = {};  // sum_k w_jk of the updates; of the candidates kept as prediction
+    PredictedMeasurement pm[kMaxModes];
+    Eigen::LLT<MeasCov> llt[kMaxModes];
+    bool can[kMaxModes] = {};
+    const Measurement* geometry = nullptr;  // the candidate whose sensor and R pm[] were formed for
+    VecM nu_bar = VecM::Zero();
+    MatM S_published = MatM::Zero();
+    bool have_S = false;
+    double used = 0.0;
+    for (std::size_t k = 0; k < n; ++k) {
+      const double b = probability[k];
+      if (!(b > 0.0)) continue;
+      const Measurement& m = detections[k];
+      if (!geometry || !same_geometry(*geometry, m, M)) {
+        const MeasCov R = m.covariance.topLeftCorner(M, M);
+        for (int j = 0; j < count_; ++j) {
+          enter(j);
+          can[j] = mode(j).predict_measurement(m, R, pm[j]) && pm[j].z.size() == M;
+          if (can[j]) {
+            llt[j].compute(pm[j].S);
+            can[j] = llt[j].info() == Eigen::Success;
+          }
+          pass_warnings(j);
+        }
+        geometry = &m;
+      }
+      double ll[kMaxModes];
+      bool ok[kMaxModes];
+      VecM nus[kMaxModes];
+      MatM Ss[kMaxModes];
+      const VecM* nu_j[kMaxModes];
+      const MatM* S_j[kMaxModes];
+      for (int j = 0; j < count_; ++j) {
+        ok[j] = can[j];
+        ll[j] = -std::numeric_limits<double>::infinity();
+        nus[j].setZero();
+        Ss[j].setZero();
+        if (ok[j]) {
+          MeasVec r = m.value.head(M) - pm[j].z;
+          wrap_residual(m.frame, r);
+          const double nis = llt[j].matrixL().solve(r).squaredNorm();
+          ll[j] = imm::log_likelihood_from_log_det(M, nis, pm[j].log_det_S);
+          nus[j] = r;
+          Ss[j] = pm[j].S;
+        } else {
+          count(kModeRefused);
+        }
+        nu_j[j] = &nus[j];
+        S_j[j] = &Ss[j];
+      }
+      double q[kMaxModes];
+      if (!imm::candidate_mode_weights(st_.c, ll, ok, count_, q)) continue;  // no mode could use it: dropped
+      for (int j = 0; j < count_; ++j) {
+        const double w = b * q[j];
+        if (ok[j]) {
+          weights_[static_cast<std::size_t>(j) * n + k] = w;
+          W[j] += w;
+        } else {
+          kept[j] += w;
+        }
+      }
+      used += b;
+      VecM nu;
+      MatM S;
+      imm::innovation_mixture<M>(st_.c, ok, count_, nu_j, S_j, nu, S);
+      nu_bar += b * nu;
+      if (!have_S) S_published = S;
+      have_S = true;
+    }
+    if (!(used > 0.0)) {
+      warn("no mode could use any candidate detection at t=" + std::to_string(time()) + " s; none used");
+      return false;  // nothing changed: the prediction, mode probabilities as before
+    }
+    const double total = none + used;
+    double mu[kMaxModes];
+    for (int j = 0; j < count_; ++j) {
+      const double prediction = none * st_.c[j] + kept[j];
+      const double a = prediction + W[j];  // total * mu_j
+      mu[j] = a / total;
+      if (!(a > 0.0) || !(W[j] > 0.0)) continue;  // mu_j = 0, or all of it on the prediction: nothing to update
+      const std::span<double> w(weights_.data() + static_cast<std::size_t>(j) * n, n);
+      for (double& v : w) v /= a;
+      enter(j);
+      if (!mode(j).update_weighted(detections.first(n), w, prediction / a, M)) count(kModeRefused);
+      pass_warnings(j);
+    }
+    std::copy(mu, mu + count_, st_.mu);
+    imm::normalise(st_.mu, count_);
+    mixed_ = false;
+    publish_probabilities();
+    nu_bar /= total;
+    double nis = 0.0;
+    if (!imm::quadratic_form<M>(S_published, nu_bar, nis)) nis = 0.0;
+    accept_update<M>(nu_bar, S_published, nis);
+    return true;
+  }
+
   template <int M>
   void publish_innovation(const bool* used) {
     Eigen::Matrix<double, M, 1> nus[kMaxModes];
@@ -544,6 +773,7 @@ class ComponentImmEstimator final : public Estimator {
     imm::VecC x0s[kMaxModes];  // mixed starts
     imm::MatC P0s[kMaxModes];
   } st_;
+  std::vector<double> weights_;  // update_weighted's w_jk / mu_j, mode by mode (grown, reused)
   // Scratch (fill is const: what it forms is no state of the filter).
   mutable Estimate scratch_[kMaxModes];
   mutable imm::CommonEstimate common_[kMaxModes];
@@ -745,7 +975,10 @@ void register_components(Registrar& r) {
       "Gaussian innovation likelihoods in the log domain; the published estimate is the moment-matched mixture (9 "
       "states if any mode has acceleration). Annotations <id>.p_<mode name>: the mode probabilities after each "
       "update. Initialised by two-point differencing (all modes alike). Adapters may replace R (not the modes' "
-      "process noise). See docs/filters.md.";
+      "process noise). Under a probabilistic associator (assoc.pda, assoc.jpda): the IMM-PDA combined update "
+      "(Houles & Bar-Shalom 1989) - joint weights w_jk = beta_k c_j g_jk / sum_i c_i g_ik and w_j0 = beta_0 c_j, mode "
+      "probabilities mu_j = w_j0 + sum_k w_jk, each mode's own combined update with w_jk / mu_j (component modes "
+      "must take weighted updates, as filter.ekf and filter.ukf do). See docs/filters.md.";
   d.accepts = mask(ItemKind::Measurement);
   d.produces = mask(ItemKind::Estimate);
   d.accepts_frames = mask(Frame::Spherical);
