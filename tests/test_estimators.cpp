@@ -343,7 +343,7 @@ TEST_CASE("one-point starts: at rest with the velocity prior") {
 // mixture of the prediction and of each candidate's own update, checked against clones updated one
 // detection each and, for filter.kalman, against the textbook PDA equations with H written out
 // (Bar-Shalom, Willett & Tian 2011, eq. 3.4.2-1 to 3.4.2-4).
-TEST_CASE("weighted updates: the moment-matched mixture of the candidates' updates") {
+TEST_CASE("weighted updates: the mixture of the candidates' updates") {
   int covered = 0;
   for (const Case& c : cases()) {
     auto e = test::fixture().make_estimator(c.type, c.params);
@@ -455,7 +455,7 @@ TEST_CASE("weighted updates: the moment-matched mixture of the candidates' updat
   CHECK(covered >= 11);  // kalman (CV, CA, planar), ekf (spherical, CA, polar), ukf, imm (two records, two components)
 }
 
-TEST_CASE("weighted updates: one sure detection is the plain update; none used changes nothing") {
+TEST_CASE("weighted updates: a sure detection is the plain update") {
   for (const Case& c : cases()) {
     auto e = test::fixture().make_estimator(c.type, c.params);
     if (!e->takes_weighted_updates()) continue;

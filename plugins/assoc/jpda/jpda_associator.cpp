@@ -1,4 +1,5 @@
 // Purpose: assoc.jpda — joint probabilistic data association: per cluster of tracks that share gated detections, the marginal probability that each detection is each track's over all joint events (exact enumeration up to max_events, loopy belief propagation above), optionally with each track's existence (JIPDA), for a combined update through each track's estimator.
+#include "assignment/k_best_assignment.hpp"
 #include "association/assumed_sensor.hpp"
 #include "association/existence.hpp"
 #include "association/gated_pairs.hpp"
@@ -25,7 +26,65 @@ struct JpdaSettings {
   double initiation_threshold = 0.0;
   double survival = 0.0;  // > 0: JIPDA
   std::uint64_t max_events = 10000;
+  enum class Approximation { BeliefPropagation, KBest } approximation = Approximation::BeliefPropagation;
   association::LbpOptions lbp;
+  int k_best = 100;
+};
+
+// k-best JPDA (the marginals from the k most likely joint events only; Murty's ranking, as MATLAB's
+// trackerJPDA "k-best" and Stone Soup's k-best JPDA): a cluster's joint events are the assignments
+// of its n x (m + n) matrix — track t to detection d at cost -log l_td (gated pairs, else +inf), or
+// to its own miss column at -log w_t0 (the other tracks' miss columns +inf) — so the k cheapest
+// assignments (KBestAssignment, plugins/lib/assignment) are the k heaviest events, weight
+// exp(-(cost - least cost)). With k at least the cluster's event count this is exact JPDA.
+class KBestMarginals {
+ public:
+  // Fills pair_beta (the cluster's pairs' order) and miss_beta (its tracks' order).
+  void run(const association::JpdaCluster& c, std::span<const double> log_miss, int k) {
+    const int n = c.size_tracks(), m = c.size_detections(), cols = m + n;
+    cost_.assign(static_cast<std::size_t>(n) * static_cast<std::size_t>(cols), std::numeric_limits<double>::infinity());
+    column_pair_.assign(static_cast<std::size_t>(n) * static_cast<std::size_t>(cols), -1);
+    for (std::size_t k2 = 0; k2 < c.pairs.size(); ++k2) {
+      const association::JpdaClusterPair& p = c.pairs[k2];
+      const std::size_t at = static_cast<std::size_t>(p.track) * static_cast<std::size_t>(cols) + static_cast<std::size_t>(p.detection);
+      cost_[at] = -p.log_weight;
+      column_pair_[at] = static_cast<int>(k2);
+    }
+    for (int t = 0; t < n; ++t)
+      cost_[static_cast<std::size_t>(t) * static_cast<std::size_t>(cols) + static_cast<std::size_t>(m + t)] =
+          -log_miss[static_cast<std::size_t>(c.tracks[static_cast<std::size_t>(t)])];
+    const std::span<const assignment::RankedAssignment> best = kbest_.solve(cost_, n, cols, k);
+    pair_.assign(c.pairs.size(), 0.0);
+    miss_.assign(static_cast<std::size_t>(n), 0.0);
+    events_ = best.size();
+    if (best.empty()) return;  // cannot happen: every track has its miss column
+    const double least = best.front().total_cost;
+    double total = 0.0;
+    for (const assignment::RankedAssignment& a : best) {
+      const double w = std::exp(least - a.total_cost);
+      total += w;
+      for (int t = 0; t < n; ++t) {
+        const int col = a.column_for_row[static_cast<std::size_t>(t)];
+        if (col >= m) {
+          miss_[static_cast<std::size_t>(t)] += w;
+        } else {
+          pair_[static_cast<std::size_t>(column_pair_[static_cast<std::size_t>(t) * static_cast<std::size_t>(cols) +
+                                                      static_cast<std::size_t>(col)])] += w;
+        }
+      }
+    }
+    for (double& b : pair_) b /= total;
+    for (double& b : miss_) b /= total;
+  }
+  std::span<const double> pair_beta() const { return pair_; }
+  std::span<const double> miss_beta() const { return miss_; }
+  std::size_t events() const { return events_; }
+
+ private:
+  assignment::KBestAssignment kbest_;
+  std::vector<double> cost_, pair_, miss_;
+  std::vector<int> column_pair_;
+  std::size_t events_ = 0;
 };
 
 // Parametric JPDA (T. E. Fortmann, Y. Bar-Shalom and M. Scheffe, "Sonar tracking of multiple targets
@@ -78,16 +137,26 @@ class JpdaAssociator final : public Associator {
         for (int t : cl.tracks) none_[static_cast<std::size_t>(t)] = 1.0;
         continue;
       }
-      const association::JpdaReport report = marginals_.marginals(cl, log_miss_, s_.max_events, s_.lbp);
-      if (report.method == association::JpdaMethod::exact) {
-        ++out.exact_clusters;
-      } else {
+      std::span<const double> miss, pair;
+      if (s_.approximation == JpdaSettings::Approximation::KBest &&
+          association::jpda_events_upper_bound(cl) > s_.max_events && counter_.count(cl, s_.max_events) > s_.max_events) {
+        kbest_.run(cl, log_miss_, s_.k_best);
         ++out.approximate_clusters;
-        if (!report.lbp.converged) ++out.unconverged_clusters;
+        miss = kbest_.miss_beta();
+        pair = kbest_.pair_beta();
+      } else {
+        const association::JpdaReport report = marginals_.marginals(cl, log_miss_, s_.max_events, s_.lbp);
+        if (report.method == association::JpdaMethod::exact) {
+          ++out.exact_clusters;
+        } else {
+          ++out.approximate_clusters;
+          if (!report.lbp.converged) ++out.unconverged_clusters;
+        }
+        miss = marginals_.miss_beta();
+        pair = marginals_.pair_beta();
       }
-      for (std::size_t t = 0; t < cl.tracks.size(); ++t) none_[static_cast<std::size_t>(cl.tracks[t])] = marginals_.miss_beta()[t];
-      for (std::size_t k = 0; k < cl.pairs.size(); ++k)
-        pair_beta_[static_cast<std::size_t>(cl.pairs[k].source)] = marginals_.pair_beta()[k];
+      for (std::size_t t = 0; t < cl.tracks.size(); ++t) none_[static_cast<std::size_t>(cl.tracks[t])] = miss[t];
+      for (std::size_t k = 0; k < cl.pairs.size(); ++k) pair_beta_[static_cast<std::size_t>(cl.pairs[k].source)] = pair[k];
     }
     // Per track, in track order (pairs_ is grouped by track ascending).
     std::size_t b = 0;
@@ -113,6 +182,8 @@ class JpdaAssociator final : public Associator {
   association::GatedPairs gated_;
   association::JpdaClusters clusters_;
   association::JpdaMarginals marginals_;
+  association::JpdaEventCounter counter_;
+  KBestMarginals kbest_;
   std::vector<association::JpdaPair> pairs_;
   std::vector<double> existence_, log_miss_, pair_beta_, none_;
 };
@@ -126,6 +197,10 @@ std::unique_ptr<TrackerPart> create_part(const Params& p) {
   s.max_events = static_cast<std::uint64_t>(p.integer("max_events"));
   s.lbp.tolerance = p.real("lbp_tolerance");
   s.lbp.max_iterations = static_cast<int>(p.integer("lbp_max_iterations"));
+  s.approximation = p.choice<JpdaSettings::Approximation>("approximation");
+  s.k_best = static_cast<int>(p.integer("k_best"));
+  if (s.approximation != JpdaSettings::Approximation::KBest && p.given("k_best"))
+    throw p.error("k_best", "is the number of joint events of approximation: k_best");
   return std::make_unique<JpdaAssociator>(s);
 }
 
@@ -143,7 +218,9 @@ void register_components(Registrar& r) {
       "detections), each computed on its own: by exact enumeration when it has at most max_events joint events "
       "(sum_k C(n,k) C(m,k) k! for n tracks fully competing for m detections), else by loopy belief propagation "
       "(Williams & Lau 2014; close to exact on average, up to ~0.3 off on one beta where two tracks compete hard for "
-      "two detections), the choice counted per scan in the tracker's summary. The tracker updates each track with its "
+      "two detections) or, with approximation: k_best, from the k most likely joint events (Murty's k best assignments "
+      "of the cluster's matrix of -log l and -log(1 - P_D P_G); exact when k reaches the event count), the choice "
+      "counted per scan in the tracker's summary. The tracker updates each track with its "
       "candidates at once (the combined update, as for assoc.pda). With survival_probability p_s: JIPDA (Musicki & "
       "Evans 2004) - each track's existence r is predicted as p_s r, its miss factor is 1 - P_D P_G r and its "
       "detection factors r P_D N / lambda; the posterior existence and the probabilities given existence are as for "
@@ -168,6 +245,13 @@ void register_components(Registrar& r) {
                                        "one by loopy belief propagation")
           .def("10000")
           .at_least(1),
+      ParamSpec::choice<JpdaSettings::Approximation>(
+          "approximation",
+          {{JpdaSettings::Approximation::BeliefPropagation, "belief_propagation"}, {JpdaSettings::Approximation::KBest, "k_best"}},
+          "above max_events: loopy belief propagation (Williams & Lau 2014), or the k most likely joint events (Murty's "
+          "ranking over the cluster's assignment matrix)")
+          .def("belief_propagation"),
+      ParamSpec::integer("k_best", "approximation: k_best: the number of joint events kept").def("100").at_least(1),
       ParamSpec::real("lbp_tolerance", Dimension{}, "belief propagation stops when no message changes by more than this (relative)")
           .def("1e-9")
           .positive(),

@@ -148,15 +148,15 @@ struct SetCollector : Component {
 
 }  // namespace
 
-TEST_CASE("JPDA probabilities equal the enumeration of the scan's joint events") {
+TEST_CASE("JPDA equals the enumeration of the joint events") {
   check_against_brute("{ gate_probability: 0.99 }", 0.0);
 }
 
-TEST_CASE("JIPDA probabilities and existence equal the enumeration") {
+TEST_CASE("JIPDA and existence equal the enumeration") {
   check_against_brute("{ gate_probability: 0.99, survival_probability: 0.97 }", 0.97);
 }
 
-TEST_CASE("above max_events a cluster goes to belief propagation, counted") {
+TEST_CASE("above max_events: belief propagation and counted") {
   auto exact = test::make_part<Associator>("assoc.jpda", "{}");
   auto lbp = test::make_part<Associator>("assoc.jpda", "{ max_events: 1 }");
   Rng rng(4);
@@ -183,7 +183,41 @@ TEST_CASE("above max_events a cluster goes to belief propagation, counted") {
   CHECK(worst < 0.35);  // belief propagation's own error (association/jpda_lbp.hpp)
 }
 
-TEST_CASE("JIPDA through tracker.multi: existence confirms and deletes") {
+TEST_CASE("k-best JPDA is exact once k reaches the event count") {
+  auto exact = test::make_part<Associator>("assoc.jpda", "{}");
+  auto all = test::make_part<Associator>("assoc.jpda", "{ max_events: 1, approximation: k_best, k_best: 100000 }");
+  auto few = test::make_part<Associator>("assoc.jpda", "{ max_events: 1, approximation: k_best, k_best: 3 }");
+  Rng rng(8);
+  int approximate = 0;
+  for (int trial = 0; trial < 150; ++trial) {
+    Problem p = random_problem(rng, 1 + trial % 4, 1 + trial % 5);
+    const int n = static_cast<int>(p.tracks.size());
+    AssociationProbabilities a, b, c;
+    a.clear(n);
+    b.clear(n);
+    c.clear(n);
+    exact->associate_probabilities(p.tracks, p.scan, a);
+    all->associate_probabilities(p.tracks, p.scan, b);
+    few->associate_probabilities(p.tracks, p.scan, c);
+    approximate += b.approximate_clusters;
+    CHECK(b.exact_clusters == 0);
+    for (int i = 0; i < n; ++i) {
+      CHECK(b.none(i) == Approx(a.none(i)).epsilon(1e-11).margin(1e-13));
+      REQUIRE(b.of(i).size() == a.of(i).size());
+      for (size_t k = 0; k < a.of(i).size(); ++k) {
+        CHECK(b.of(i)[k].detection == a.of(i)[k].detection);
+        CHECK(b.of(i)[k].probability == Approx(a.of(i)[k].probability).epsilon(1e-11).margin(1e-13));
+      }
+      double sum = c.none(i);
+      for (const auto& e : c.of(i)) sum += e.probability;
+      CHECK(sum == Approx(1.0).epsilon(1e-12));  // 3 events only: still a distribution
+    }
+  }
+  CHECK(approximate > 100);
+  CHECK_THROWS_WITH(test::make_part<Associator>("assoc.jpda", "{ k_best: 5 }"), Catch::Contains("approximation: k_best"));
+}
+
+TEST_CASE("JIPDA tracker: existence confirms and deletes") {
   auto n = test::make("tracker.multi",
                       "{ estimator: { type: filter.kalman, q: 0.1 m2/s3 }, "
                       "associator: { type: assoc.jpda, survival_probability: 0.99 }, "
@@ -238,7 +272,7 @@ TEST_CASE("JIPDA through tracker.multi: existence confirms and deletes") {
   CHECK(confirmed(out.sets.back(), 2) == 0);  // deleted once its existence fell
 }
 
-TEST_CASE("existence-reading parts need an associator that keeps existence") {
+TEST_CASE("existence parts need an existence-keeping associator") {
   for (const char* assoc : {"assoc.gnn", "assoc.jpda", "assoc.pda"}) {
     INFO(assoc);
     try {

@@ -29,7 +29,7 @@ struct SetCollector : Component {
 
 }  // namespace
 
-TEST_CASE("probabilities: the PDA's closed form per track, gated") {
+TEST_CASE("the PDA's closed form per track inside the gate") {
   auto a = test::make_part<Associator>("assoc.pda", "{ gate_probability: 0.99 }");
   REQUIRE(a->probabilistic());
   Rng rng(3);
@@ -76,7 +76,7 @@ TEST_CASE("probabilities: the PDA's closed form per track, gated") {
   }
 }
 
-TEST_CASE("probabilities: likelihoods below the double range") {
+TEST_CASE("likelihoods below the double range") {
   // S = 1e206 I: N(nu; 0, S) ~ 1e-310, a denormal with a few digits left; over lambda = 1e-305
   // the ratio is ~6e-6. Formed in the log domain, the probabilities keep their full precision.
   auto a = test::make_part<Associator>("assoc.pda", "{ gate_probability: 0.99, detection_probability: 0.9 }");
@@ -106,7 +106,7 @@ TEST_CASE("probabilities: likelihoods below the double range") {
   CHECK(out.none(0) == Approx(w0 / (w0 + 2 * l)).epsilon(1e-9));
 }
 
-TEST_CASE("through tracker.multi: two targets in clutter, two tracks that keep them") {
+TEST_CASE("tracker.multi: two targets in clutter keep their tracks") {
   auto n = test::make("tracker.multi",
                       "{ estimator: { type: filter.kalman, q: 0.1 m2/s3 }, associator: { type: assoc.pda }, "
                       "initiator: { type: init.m_of_n, m: 3, n: 4, max_speed: 50 m/s }, "
@@ -157,7 +157,7 @@ TEST_CASE("through tracker.multi: two targets in clutter, two tracks that keep t
   }
 }
 
-TEST_CASE("estimators and adapters that cannot take combined updates are refused") {
+TEST_CASE("estimators and adapters without combined updates refused") {
   try {
     test::make("tracker.multi",
                "{ estimator: { type: filter.decoupled },\n"
