@@ -242,22 +242,24 @@ void register_components(Registrar& r) {
           .positive()
           .at_most(1),
       ParamSpec::integer("max_events", "a cluster with at most this many joint events is enumerated exactly; a larger "
-                                       "one by loopy belief propagation")
+                                       "one by the approximation (at most 1e7: about 0.1 s per cluster)")
           .def("10000")
-          .at_least(1),
+          .at_least(1)
+          .at_most(1e7),
       ParamSpec::choice<JpdaSettings::Approximation>(
           "approximation",
           {{JpdaSettings::Approximation::BeliefPropagation, "belief_propagation"}, {JpdaSettings::Approximation::KBest, "k_best"}},
           "above max_events: loopy belief propagation (Williams & Lau 2014), or the k most likely joint events (Murty's "
           "ranking over the cluster's assignment matrix)")
           .def("belief_propagation"),
-      ParamSpec::integer("k_best", "approximation: k_best: the number of joint events kept").def("100").at_least(1),
+      ParamSpec::integer("k_best", "approximation: k_best: the number of joint events kept").def("100").at_least(1).at_most(100000),
       ParamSpec::real("lbp_tolerance", Dimension{}, "belief propagation stops when no message changes by more than this (relative)")
           .def("1e-9")
           .positive(),
       ParamSpec::integer("lbp_max_iterations", "belief propagation stops after this many rounds (counted as unconverged)")
           .def("1000")
-          .at_least(1),
+          .at_least(1)
+          .at_most(1000000),
   };
   d.create_part = create_part;
   r.add(std::move(d));
