@@ -134,6 +134,12 @@ class ImmEstimator final : public Estimator {
         imm::from_common<order_of<decltype(s)>>(x0s_[j], P0s_[j], s.x_, s.P_);
         s.predict_state(T, same_interval(T, s.last_interval()));
       });
+    // The prediction's mode probabilities are the Markov chain's c_j = sum_i pi_ij mu_i (Blom &
+    // Bar-Shalom 1988): through a coast (no update) they move towards the chain's stationary
+    // distribution, the next mixing starts from them, and the published estimate combines the
+    // predicted modes with them rather than with the last posterior (issue 25).
+    std::copy(c_, c_ + count_, mu_);
+    publish_probabilities();
     mixed_ = true;
   }
 
@@ -547,6 +553,9 @@ class ComponentImmEstimator final : public Estimator {
       mode(j).predict(T);
       pass_warnings(j);
     }
+    // The predicted mode probabilities, as ImmEstimator::predict (a coast moves them along the chain).
+    for (int j = 0; j < count_; ++j) st_.mu[j] = st_.c[j];
+    publish_probabilities();
     mixed_ = true;
   }
 

@@ -397,3 +397,47 @@ TEST_CASE("IMM-PDA under tracker.multi keeps a manoeuvring target") {
     CHECK(updated > 0.8 * n_err);
   }
 }
+
+// Through a coast (predictions without updates) the mode probabilities follow the Markov chain
+// (issue 25): two identical CV modes, Pi = [[0.9, 0.1], [0.1, 0.9]], mu0 = [1, 0] after the start,
+// give p_a = 0.5 + 0.5 * 0.8^k after k predictions — the mode probabilities published with each
+// predicted estimate, and the ones the next update starts from.
+TEST_CASE("a coast moves the mode probabilities along the chain") {
+  const std::string records =
+      "{ modes: [{ name: a, motion: constant_velocity, q: 1 m2/s3 }, { name: b, motion: constant_velocity, q: 1 m2/s3 }], "
+      "transition: [0.9, 0.1, 0.1, 0.9], initial_probabilities: [1, 0] }";
+  const std::string components =
+      "{ modes: [{ type: filter.ekf, motion: constant_velocity, q: 1 m2/s3 }, { type: filter.ekf, motion: "
+      "constant_velocity, q: 1 m2/s3 }], transition: [0.9, 0.1, 0.1, 0.9], initial_probabilities: [1, 0] }";
+  for (const std::string& params : {records, components}) {
+    INFO(params);
+    auto imm = test::fixture().make_estimator("filter.imm", params);
+    Track t;
+    bind(*imm, t);
+    Rng rng(2);
+    REQUIRE_FALSE(imm->reset());
+    for (int k = 0; k < 2; ++k) {  // the two-point start: mu stays mu0 = [1, 0]
+      const Measurement m = spherical(truth(k), k, &rng);
+      t.time = k;
+      imm->measurement_noise() = m.covariance;
+      (void)imm->initiate(m, 3);
+    }
+    REQUIRE(t.annotations.size() == 2);
+    CHECK(t.annotations[0] == Approx(1.0));
+    for (int k = 1; k <= 10; ++k) {
+      t.time = 1 + k;
+      imm->predict(1.0);
+      INFO("k = " << k);
+      CHECK(t.annotations[0] == Approx(0.5 + 0.5 * std::pow(0.8, k)).epsilon(1e-12));
+      CHECK(t.annotations[0] + t.annotations[1] == Approx(1.0).epsilon(1e-14));
+    }
+    // Then an update starts from the chain's c: two identical modes have equal likelihoods, so the
+    // posterior is the prediction's c = Pi' mu = [0.5 + 0.5 * 0.8^11, ...].
+    const Measurement m = spherical(truth(12), 12, &rng);
+    t.time = 12;
+    imm->predict(1.0);
+    imm->measurement_noise() = m.covariance;
+    REQUIRE(imm->update(m, 3));
+    CHECK(t.annotations[0] == Approx(0.5 + 0.5 * std::pow(0.8, 11)).epsilon(1e-9));
+  }
+}
