@@ -434,6 +434,7 @@ class Engine {
     kept_.clear();
     cache_.clear();
     cache_keys_.clear();
+    murty_entry_ = -1;
     std::fill(cache_table_.begin(), cache_table_.end(), -1);
     answer_child_.clear();
     answer_costs_.clear();
@@ -457,7 +458,17 @@ class Engine {
         cheapest += c;
       }
       if (full() && !(H.score + bonus - cheapest > worst_kept())) continue;
+      // The first parent ranks its clusters as deep as max_hypotheses at once (its children fill the
+      // places); the others start from each cluster's best, enough to test whether their best child
+      // enters, and go deeper only on demand.
+      first_k_ = h == 0 ? s_.max_hypotheses : 1;
       solve_clusters(m);
+      if (full()) {
+        double best = forced_cost_;
+        for (std::size_t c = 0; c < cluster_entry_.size(); ++c)
+          best += answer_costs_[static_cast<std::size_t>(cache_[static_cast<std::size_t>(cluster_entry_[c])].cost_first)];
+        if (!(H.score + bonus - best > worst_kept())) continue;
+      }
       // The joint answers best first, while they can still enter.
       lists_.e = this;
       sums_.start(lists_);
@@ -610,7 +621,7 @@ class Engine {
       cache_keys_.insert(cache_keys_.end(), key_.begin(), key_.end());
       cache_insert(h, entry);
       e = static_cast<int>(cache_.size()) - 1;
-      rank_cluster(c, e, std::min(2, s_.max_hypotheses));
+      rank_cluster(c, e, first_k_);
     }
     cluster_entry_.push_back(e);
   }
@@ -621,7 +632,7 @@ class Engine {
     const CacheEntry& x = cache_[static_cast<std::size_t>(e)];
     if (x.complete) return false;
     const int before = x.answers;
-    rank_cluster(c, e, std::min(s_.max_hypotheses, 2 * x.requested));
+    rank_cluster(c, e, std::min(s_.max_hypotheses, std::max(2, 2 * x.requested)));
     return cache_[static_cast<std::size_t>(e)].answers > before;
   }
 
@@ -674,7 +685,10 @@ class Engine {
         cost_[static_cast<std::size_t>(r * w + b + r)] = -miss_dL_;
         child_[static_cast<std::size_t>(r * w + b + r)] = l.miss_child;
       }
-      const std::span<const assignment::RankedAssignment> answers = murty_.solve(cost_, a, w, k);
+      // The solver still holds this cluster's search when it ranked it last: continue it.
+      const bool resume = murty_entry_ == e;
+      const std::span<const assignment::RankedAssignment> answers = resume ? murty_.resume(k) : murty_.solve(cost_, a, w, k);
+      murty_entry_ = e;
       for (const assignment::RankedAssignment& x : answers) {
         answer_costs_.push_back(x.total_cost);
         for (int r = 0; r < a; ++r)
@@ -973,6 +987,8 @@ class Engine {
   std::vector<int> cache_keys_, cache_table_, key_;
   std::vector<Option> single_;
   double forced_cost_ = 0.0;
+  int first_k_ = 1;       // the k of a cluster's first ranking
+  int murty_entry_ = -1;  // the cache entry whose search murty_ holds (resumable)
   RankedSums sums_;
   ClusterLists lists_;
   std::vector<int> cluster_entry_;
