@@ -73,6 +73,9 @@ struct RankedAssignment {
 // the chosen entries in line order; when rounding makes a child's total a few ulps below an
 // answer already found, it is moved in front (an insertion), so the output is sorted exactly.
 //
+// resume(k) after solve(): the same search continued to k answers (the last answer's subproblem
+// partitioned then), identical to solve(k) and solving nothing twice.
+//
 // Storage: all work arrays are members (vectors cleared, never shrunk; the queue is a heap over
 // a vector). Once a solver has seen a problem as large, with as many answers and subproblems, a
 // solve allocates nothing.

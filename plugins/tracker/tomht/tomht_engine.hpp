@@ -79,10 +79,11 @@ struct Counters {
 //     to start a tree would score) and c_i,miss = -dL_miss, so that
 //         score(child) = score(h) + sum_j L0_j - sum of the chosen costs.
 //     The problem splits into clusters of rows sharing gated detections; each cluster's k best
-//     assignments come from KBestAssignment (Murty 1968, Miller, Stone & Cox 1997) — lazily (k = 2,
-//     doubled when the enumeration needs more) and once per scan for the same leaves (parents
-//     share most clusters) — and the k best joint ones from RankedSums. The children of all hypotheses compete for max_hypotheses places
-//     (best score first; ties by parent rank, then by rank within the parent: deterministic). A
+//     assignments come from KBestAssignment (Murty 1968, Miller, Stone & Cox 1997) — once per scan
+//     for the same leaves (parents share most clusters), and lazily: the first parent's to
+//     max_hypotheses, the others' to their best (the skip test), then twice as deep on demand,
+//     resuming the search (KBestAssignment::resume) — and the k best joint ones from RankedSums.
+//     The children of all hypotheses compete for max_hypotheses places (best score first; ties by parent rank, then by rank within the parent: deterministic). A
 //     parent whose best possible child (each row's cheapest option) cannot enter is skipped.
 //  3. Track management on the best hypothesis: its tree is confirmed when the leaf's L reaches
 //     T_c = ln((1 - beta) / alpha) (Wald's SPRT on the score, Blackman 2004; as init.score).
