@@ -83,8 +83,10 @@ struct Counters {
 //     for the same leaves (parents share most clusters), and lazily: the first parent's to
 //     max_hypotheses, the others' to their best (the skip test), then twice as deep on demand,
 //     resuming the search (KBestAssignment::resume) — and the k best joint ones from RankedSums.
-//     The children of all hypotheses compete for max_hypotheses places (best score first; ties by parent rank, then by rank within the parent: deterministic). A
-//     parent whose best possible child (each row's cheapest option) cannot enter is skipped.
+//     The children of all hypotheses compete for max_hypotheses places (best score first; ties
+//     by parent rank, then by rank within the parent: deterministic). A parent whose best
+//     possible child cannot enter is skipped (tested first by each row's cheapest option, then by
+//     its clusters' best answers).
 //  3. Track management on the best hypothesis: its tree is confirmed when the leaf's L reaches
 //     T_c = ln((1 - beta) / alpha) (Wald's SPRT on the score, Blackman 2004; as init.score).
 //     A leaf is dead — it gets no children and its hypotheses drop the tree — after max_misses
