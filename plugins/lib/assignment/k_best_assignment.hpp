@@ -73,6 +73,9 @@ struct RankedAssignment {
 // the chosen entries in line order; when rounding makes a child's total a few ulps below an
 // answer already found, it is moved in front (an insertion), so the output is sorted exactly.
 //
+// resume(k) after solve(): the same search continued to k answers (the last answer's subproblem
+// partitioned then), identical to solve(k) and solving nothing twice.
+//
 // Storage: all work arrays are members (vectors cleared, never shrunk; the queue is a heap over
 // a vector). Once a solver has seen a problem as large, with as many answers and subproblems, a
 // solve allocates nothing.
@@ -126,6 +129,18 @@ class KBestAssignment {
                static_cast<std::ptrdiff_t>(m.rowStride()), static_cast<std::ptrdiff_t>(m.colStride()), root, k);
   }
 
+  // More answers of the last solve(): the first k of the same problem, exactly as solve(..., k)
+  // gives them (the search goes on where it stopped: the subproblem of the last answer is
+  // partitioned now, and nothing is solved twice). For a caller that learns only while reading
+  // the answers how many it needs (the track-oriented MHT's lazily ranked clusters). Views as for
+  // solve(); k below the answers found gives the first k.
+  std::span<const RankedAssignment> resume(int k) {
+    check_k(k);
+    results_.clear();
+    if (!searched_) return results_;
+    return search(k);
+  }
+
   // Subproblems handed to LinearAssignment by the last solve, the root included (for tests and
   // cost accounting).
   long long subproblems_solved() const { return subproblems_solved_; }
@@ -169,7 +184,10 @@ class KBestAssignment {
     order_.clear();
     columns_.clear();
     results_.clear();
-    if (k == 0 || !root.feasible) return {};
+    searched_ = false;
+    pending_ = -1;
+    rows_ = rows;
+    if (!root.feasible) return {};
 
     // The costs line-major (line s, large index l at work_[s * large_ + l]), read by every
     // subproblem; the root's answer as a line -> large map.
@@ -190,18 +208,36 @@ class KBestAssignment {
     memory::assign_grown(fixed_, n, -1);
     parent_forbid_.clear();
     push_node();
+    searched_ = true;
+    return search(k);
+  }
 
+  // Pops answers until k are found (or none is left), then lays out the first k.
+  std::span<const RankedAssignment> search(int k) {
+    const auto n = static_cast<std::size_t>(small_);
+    (void)n;
+    if (pending_ >= 0 && static_cast<int>(answer_costs_.size()) < k) {
+      partition(pending_);  // the last answer's children: what a longer search would have made
+      pending_ = -1;
+    }
     while (!heap_.empty() && static_cast<int>(answer_costs_.size()) < k) {
       std::pop_heap(heap_.begin(), heap_.end(), later());
       const int id = heap_.back();
       heap_.pop_back();
       record_answer(nodes_[static_cast<std::size_t>(id)]);
-      if (static_cast<int>(answer_costs_.size()) < k) partition(id);
+      if (static_cast<int>(answer_costs_.size()) < k)
+        partition(id);
+      else
+        pending_ = id;
     }
 
     // Rows' columns of each answer in sorted order, then the views (after all growth).
-    const auto r = static_cast<std::size_t>(rows);
-    for (const int a : order_) {
+    columns_.clear();
+    results_.clear();
+    const auto r = static_cast<std::size_t>(rows_);
+    const std::size_t count = std::min(order_.size(), static_cast<std::size_t>(k));
+    for (std::size_t q = 0; q < count; ++q) {
+      const int a = order_[q];
       const std::size_t base = columns_.size();
       columns_.resize(base + r, -1);
       for (int s = 0; s < small_; ++s) {
@@ -212,7 +248,7 @@ class KBestAssignment {
           columns_[base + static_cast<std::size_t>(s)] = l;
       }
     }
-    for (std::size_t q = 0; q < order_.size(); ++q)
+    for (std::size_t q = 0; q < count; ++q)
       results_.push_back({answer_costs_[static_cast<std::size_t>(order_[q])],
                           std::span<const int>(columns_.data() + q * r, r)});
     return results_;
@@ -330,7 +366,9 @@ class KBestAssignment {
   }
 
   LinearAssignment solver_;
-  int small_ = 0, large_ = 0;
+  int small_ = 0, large_ = 0, rows_ = 0;
+  bool searched_ = false;  // a search to resume: the last solve's queue and answers
+  int pending_ = -1;       // the last answer's node, not yet partitioned
   bool transposed_ = false;
   long long subproblems_solved_ = 0;
   std::vector<double> work_;  // costs line-major

@@ -447,3 +447,27 @@ TEST_CASE("bad input is refused with a clear exception", "[k_best]") {
   CHECK(got[0].total_cost == 1.0);
   CHECK(got[1].total_cost == 2.0);
 }
+
+TEST_CASE("resume continues a search as a longer solve would", "[k_best]") {
+  std::mt19937 gen(77);
+  std::uniform_real_distribution<double> uniform(0.0, 1.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    const int rows = 1 + trial % 5, cols = 1 + (trial / 5) % 6;
+    std::vector<double> cost(static_cast<std::size_t>(rows * cols));
+    for (double& c : cost) c = uniform(gen) < 0.2 ? std::numeric_limits<double>::infinity() : std::floor(uniform(gen) * 5);
+    const int k1 = 1 + trial % 3, k2 = k1 + 1 + trial % 7;
+    KBestAssignment once, twice;
+    const auto full = once.solve(cost, rows, cols, k2);
+    std::vector<std::pair<double, std::vector<int>>> expected;
+    for (const auto& a : full) expected.push_back({a.total_cost, {a.column_for_row.begin(), a.column_for_row.end()}});
+    const auto first = twice.solve(cost, rows, cols, k1);
+    CHECK(first.size() == std::min<std::size_t>(expected.size(), static_cast<std::size_t>(k1)));
+    const auto more = twice.resume(k2);
+    REQUIRE(more.size() == expected.size());
+    for (std::size_t q = 0; q < more.size(); ++q) {
+      CHECK(more[q].total_cost == expected[q].first);
+      CHECK(std::vector<int>(more[q].column_for_row.begin(), more[q].column_for_row.end()) == expected[q].second);
+    }
+    CHECK(twice.subproblems_solved() == once.subproblems_solved());  // nothing solved twice
+  }
+}
