@@ -1,6 +1,6 @@
 // Purpose: benchmark: tracker.multi (assoc.gnn + init.m_of_n + delete.misses, a CV filter.kalman per track; filter.ekf on spherical plots) scans per second on Stone Soup's k-d-tree tutorial scenario, a 1000-target case in Cartesian and in spherical scans, heap allocations per scan, and sink.gospa steps per second.
 //
-// Usage: trackflow-bench-tracker [--runs N] [--rounds R] [--plugins DIR] [--case kdtree|adapted|jpda|jpda_lbp|scale|spherical|gospa|all]
+// Usage: trackflow-bench-tracker [--runs N] [--rounds R] [--plugins DIR] [--case kdtree|adapted|jpda|jpda_lbp|tomht|scale|spherical|gospa|all]
 //                                [--targets N]
 // Single thread, CPU time of the process (and wall time). The scans of every run are made first by
 // sim.scenario (not timed) and stored; each round then feeds them to a fresh tracker.multi, run by
@@ -22,6 +22,7 @@
 //   jpda    the kdtree case under assoc.jpda (exact per cluster up to 10 000 joint events, else loopy
 //           belief propagation) with score deletion (a JPDA track rarely misses: some clutter is in its gate).
 //   jpda_lbp  the same with belief propagation on every cluster (max_events: 1), as Stone Soup's JPDAwithLBP.
+//   tomht   the kdtree case under tracker.tomht (pipelines/kdtree_mht.yaml: N = 3, <= 100 hypotheses).
 //   scale   1000 targets that live throughout and 1000 clutter detections per scan over 3 km x 3 km.
 //   spherical  the scale case's targets seen by sim.scan_radar at the centre of the region (30 m below
 //           it): [range, azimuth, elevation] plots, sigmas 0.5 m and 0.3 mrad, P_D 0.9, 1000 clutter
@@ -168,12 +169,13 @@ struct TrackerResult {
 };
 
 TrackerResult bench_tracker(const host::PluginRegistry& reg, const std::string& tracker_yaml,
-                            const std::vector<std::vector<StoredScan>>& runs, int rounds, int warm_up) {
+                            const std::vector<std::vector<StoredScan>>& runs, int rounds, int warm_up,
+                            const char* tracker_type = "tracker.multi") {
   TrackerResult res;
   double scans = 0;
   for (const auto& r : runs) scans += static_cast<double>(r.size());
   for (int round = 0; round < rounds; ++round) {
-    auto tracker = make(reg, "tracker.multi", tracker_yaml);
+    auto tracker = make(reg, tracker_type, tracker_yaml);
     TrackConsumer consumer;
     const Link links[1] = {{&consumer, 0, 0xFF}};
     tracker->out.connect(links, 1);
@@ -254,11 +256,19 @@ const char* kJpdaLbpTracker =
     "  initiator: { type: init.m_of_n, m: 3, n: 4, max_speed: 10 m/s },"
     "  deleter: { type: delete.score, score_drop: 6.5, max_position_sd: 10 m } }";
 
+// The track-oriented MHT of pipelines/kdtree_mht.yaml (tracker.tomht, N = 3, at most 100 global
+// hypotheses; issue 22).
+const char* kMhtTracker =
+    "{ estimator: { type: filter.kalman, motion: constant_velocity, q: 0.005 m2/s3 },"
+    "  gate_probability: 0.99, max_speed: 4 m/s, n_scan: 3, max_hypotheses: 100,"
+    "  false_track_probability: 1e-3, start_score: 2 }";
+
 void run_tracker_case(const host::PluginRegistry& reg, const char* name, const std::string& scenario, int runs,
-                      int rounds, int warm_up, const char* tracker = kTracker, const std::string& radar = "") {
+                      int rounds, int warm_up, const char* tracker = kTracker, const std::string& radar = "",
+                      const char* tracker_type = "tracker.multi") {
   double dets = 0, alive = 0;
   const auto scans = make_scans(reg, scenario, radar, runs, &dets, &alive);
-  const TrackerResult r = bench_tracker(reg, tracker, scans, rounds, warm_up);
+  const TrackerResult r = bench_tracker(reg, tracker, scans, rounds, warm_up, tracker_type);
   std::printf("%-8s %4d runs x %3zu scans, %6.1f targets alive, %7.1f detections/scan, %6.1f confirmed tracks/scan\n", name,
               runs, scans.front().size(), alive, dets, r.confirmed_per_scan);
   std::printf("         %12.0f scans/CPU-s %12.0f scans/wall-s %10.1f us/scan (CPU)\n", r.rate.cpu, r.rate.wall,
@@ -327,7 +337,7 @@ int main(int argc, char** argv) {
     else if (!std::strcmp(argv[i], "--targets")) spherical_targets = std::max(1, std::atoi(argv[i + 1]));
     else {
       std::fprintf(stderr, "unknown option %s; usage: trackflow-bench-tracker [--runs N] [--rounds R] [--plugins DIR] "
-                   "[--case kdtree|adapted|jpda|jpda_lbp|scale|spherical|gospa|all] [--targets N (spherical)]\n", argv[i]);
+                   "[--case kdtree|adapted|jpda|jpda_lbp|tomht|scale|spherical|gospa|all] [--targets N (spherical)]\n", argv[i]);
       return 2;
     }
   }
@@ -348,6 +358,8 @@ int main(int argc, char** argv) {
   if (which == "all" || which == "jpda") run_tracker_case(reg, "jpda", kdtree_scenario, runs, rounds, 4, kJpdaTracker);
   if (which == "all" || which == "jpda_lbp")
     run_tracker_case(reg, "jpda_lbp", kdtree_scenario, runs, rounds, 4, kJpdaLbpTracker);
+  if (which == "all" || which == "tomht")
+    run_tracker_case(reg, "tomht", kdtree_scenario, runs, rounds, 4, kMhtTracker, "", "tracker.tomht");
   if (which == "all" || which == "scale")
     run_tracker_case(reg, "scale",
                      "{ period: 5 s, duration: 145 s, planar: true, region_lo: [-1500 m, -1500 m], region_hi: [1500 m, 1500 m],"

@@ -40,13 +40,17 @@ struct Settings {
   int max_misses = 3;
   int max_tracks = 10000;
   double start_score = 0.0;  // L0 of a new tree (its first detection)
+  // A cluster of more trees than this is given its best assignment only (GNN within it), counted:
+  // Murty's ranking costs O(k n^3 m) on an n-row cluster, and dense clutter chains new trees into
+  // clusters of hundreds of rows (200 clutter detections per km2 per scan: 2 s per scan unbounded).
+  int max_cluster_trees = 30;
 };
 
 // What the engine counts (summed by the component into its run result).
 struct Counters {
   std::uint64_t scans = 0, hypotheses = 0, leaves = 0, trees_started = 0, start_failed = 0, confirmed = 0,
                 deleted = 0, pruned_leaves = 0, pruned_hypotheses = 0, updates_refused = 0, track_limit_refused = 0,
-                confirmed_track_scans = 0;
+                confirmed_track_scans = 0, clusters_capped = 0;
 };
 
 // Track-oriented MHT (Blackman 2004, "Multiple hypothesis tracking for multiple target tracking",
@@ -688,6 +692,12 @@ class Engine {
         cost_[static_cast<std::size_t>(r * w + b + r)] = -miss_dL_;
         child_[static_cast<std::size_t>(r * w + b + r)] = l.miss_child;
       }
+      // Too large to rank: its best assignment only, and no more answers asked of it.
+      const bool capped = a > s_.max_cluster_trees;
+      if (capped) {
+        k = 1;
+        ++counters_.clusters_capped;
+      }
       // The solver still holds this cluster's search when it ranked it last: continue it.
       const bool resume = murty_entry_ == e;
       const std::span<const assignment::RankedAssignment> answers = resume ? murty_.resume(k) : murty_.solve(cost_, a, w, k);
@@ -697,7 +707,7 @@ class Engine {
         for (int r = 0; r < a; ++r)
           answer_child_.push_back(child_[static_cast<std::size_t>(r * w + x.column_for_row[static_cast<std::size_t>(r)])]);
       }
-      complete = static_cast<int>(answers.size()) < k || k >= s_.max_hypotheses;
+      complete = capped || static_cast<int>(answers.size()) < k || k >= s_.max_hypotheses;
     }
     CacheEntry& x = cache_[static_cast<std::size_t>(e)];
     x.child_first = child_first;

@@ -23,12 +23,13 @@ namespace {
 struct TomhtRunResult final : RunResult {
   std::uint64_t scans = 0, looks = 0, scans_not_looked = 0, scans_skipped = 0, detections = 0, hypotheses = 0,
                 leaves = 0, trees_started = 0, start_failed = 0, confirmed = 0, deleted = 0, pruned_leaves = 0,
-                pruned_hypotheses = 0, updates_refused = 0, track_limit_refused = 0, confirmed_track_scans = 0;
+                pruned_hypotheses = 0, updates_refused = 0, track_limit_refused = 0, confirmed_track_scans = 0,
+                clusters_capped = 0;
   template <class Self, class F>
   static void fields(Self& r, F&& f) {
     f(r.scans, r.looks, r.scans_not_looked, r.scans_skipped, r.detections, r.hypotheses, r.leaves, r.trees_started,
       r.start_failed, r.confirmed, r.deleted, r.pruned_leaves, r.pruned_hypotheses, r.updates_refused,
-      r.track_limit_refused, r.confirmed_track_scans);
+      r.track_limit_refused, r.confirmed_track_scans, r.clusters_capped);
   }
 };
 
@@ -36,6 +37,7 @@ class TomhtTracker final : public Component, public FieldListCodec<TomhtRunResul
  public:
   TomhtTracker(std::string node, tomht::Settings s, std::unique_ptr<Estimator> prototype)
       : node_(std::move(node)),
+        max_cluster_trees_(s.max_cluster_trees),
         spec_(prototype->measurement_spec()),
         checker_(prototype->clone()),
         engine_(std::move(s), std::move(prototype), "tracker.tomht (node '" + node_ + "')") {}
@@ -85,6 +87,7 @@ class TomhtTracker final : public Component, public FieldListCodec<TomhtRunResul
     run_.updates_refused = c.updates_refused;
     run_.track_limit_refused = c.track_limit_refused;
     run_.confirmed_track_scans = c.confirmed_track_scans;
+    run_.clusters_capped = c.clusters_capped;
     return std::make_unique<TomhtRunResult>(run_);
   }
   void merge(RunResult& result) override {
@@ -107,6 +110,11 @@ class TomhtTracker final : public Component, public FieldListCodec<TomhtRunResul
              total_.scans ? static_cast<double>(total_.confirmed_track_scans) / static_cast<double>(total_.scans) : 0.0);
     s.metric("pruned_leaves", static_cast<double>(total_.pruned_leaves));
     s.metric("pruned_hypotheses", static_cast<double>(total_.pruned_hypotheses));
+    if (total_.clusters_capped) {
+      s.metric("clusters_capped", static_cast<double>(total_.clusters_capped));
+      s.notes.push_back(std::to_string(total_.clusters_capped) + " cluster ranking(s) of more than max_cluster_trees (" +
+                        std::to_string(max_cluster_trees_) + ") trees gave their best assignment only");
+    }
     if (total_.updates_refused) s.metric("updates_refused", static_cast<double>(total_.updates_refused));
     if (total_.start_failed) s.metric("starts_failed", static_cast<double>(total_.start_failed));
     if (total_.scans_not_looked) s.metric("scans_not_looked", static_cast<double>(total_.scans_not_looked));
@@ -150,6 +158,7 @@ class TomhtTracker final : public Component, public FieldListCodec<TomhtRunResul
   }
 
   std::string node_;
+  int max_cluster_trees_ = 0;
   MeasurementSpec spec_;
   std::unique_ptr<Estimator> checker_;  // the estimator's own checks of a scan's detections
   tomht::Engine engine_;
@@ -184,6 +193,7 @@ std::unique_ptr<Component> create(const Params& p) {
   s.max_misses = static_cast<int>(p.integer("max_misses"));
   s.max_tracks = static_cast<int>(p.integer("max_tracks"));
   s.start_score = p.real("start_score");
+  s.max_cluster_trees = static_cast<int>(p.integer("max_cluster_trees"));
   return std::make_unique<TomhtTracker>(p.node(), std::move(s), std::move(estimator));
 }
 
@@ -226,7 +236,7 @@ void register_components(Registrar& r) {
           .at_least(0)
           .at_most(tomht::kWindow - 1),
       ParamSpec::integer("max_hypotheses", "global hypotheses kept per scan").def("100").at_least(1).at_most(100000),
-      ParamSpec::integer("max_leaves_per_tree", "track hypotheses kept per target tree").def("20").at_least(1),
+      ParamSpec::integer("max_leaves_per_tree", "track hypotheses kept per target tree").def("20").at_least(1).at_most(10000),
       ParamSpec::real("false_track_probability", Dimension{},
                       "alpha: probability of confirming a false track (confirmation at L >= ln((1-beta)/alpha))")
           .def("1e-6")
@@ -246,6 +256,12 @@ void register_components(Registrar& r) {
           .at_least(1),
       ParamSpec::real("start_score", Dimension{}, "L0 of a new tree, e.g. ln(beta_NT/beta_FA) (0: the reference)")
           .def("0"),
+      ParamSpec::integer("max_cluster_trees",
+                         "a cluster of more target trees than this gets its best assignment only (no ranking), counted: "
+                         "Murty's ranking grows as the cube of the cluster")
+          .def("30")
+          .at_least(1)
+          .at_most(1000),
   };
   d.create = create;
   r.add(std::move(d));
