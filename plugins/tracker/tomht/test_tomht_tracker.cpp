@@ -533,3 +533,33 @@ TEST_CASE("N-scan pruning and the leaf bound hold after every scan") {
     CHECK(pruned_somewhere > 0);  // the bounds did act
   }
 }
+
+// A cluster above max_cluster_trees is given its best assignment only, and counted: with the bound
+// at 1 every cluster of two or more trees is capped, the run still tracks both targets, and the
+// summary says how many rankings were cut.
+TEST_CASE("big clusters get their best assignment only") {
+  auto n = test::make("tracker.tomht", tomht_yaml("max_cluster_trees: 1"));
+  SetCollector out;
+  out.attach_to(*n);
+  test::start_run(*n);
+  Scenario sc;
+  for (int k = 0; k < 20; ++k) n->on_scan(sc.scan_at(k, 20), 0);
+  REQUIRE(out.sets.size() == 20);
+  CHECK(confirmed(out.sets.back()).size() == 2);
+  std::unique_ptr<RunResult> r = n->end_run();
+  n->merge(*r);
+  Summary s;
+  n->finish(s, FinishContext{});
+  REQUIRE(s.find("clusters_capped"));
+  CHECK(s.find("clusters_capped")->value > 0.0);
+  // Unbounded (the default 30 here): nothing capped.
+  auto m = test::make("tracker.tomht", tomht_yaml());
+  test::start_run(*m);
+  Scenario sc2;
+  for (int k = 0; k < 20; ++k) m->on_scan(sc2.scan_at(k, 20), 0);
+  std::unique_ptr<RunResult> r2 = m->end_run();
+  m->merge(*r2);
+  Summary s2;
+  m->finish(s2, FinishContext{});
+  CHECK_FALSE(s2.find("clusters_capped"));
+}
