@@ -3,6 +3,7 @@
 #include "association/assumed_sensor.hpp"
 #include "association/existence.hpp"
 #include "association/gated_pairs.hpp"
+#include "association/probabilistic_params.hpp"
 #include "association/jpda_clusters.hpp"
 #include "association/jpda_marginals.hpp"
 
@@ -230,17 +231,8 @@ void register_components(Registrar& r) {
       association::gate_probability_param(),
       association::AssumedSensor::detection_probability_param(),
       association::AssumedSensor::clutter_density_param(),
-      ParamSpec::real("initiation_threshold", Dimension{},
-                      "a detection whose probability of being some track's is at most this goes to the initiator "
-                      "(0: any detection in a gate starts no track)")
-          .def("0")
-          .at_least(0)
-          .at_most(1),
-      ParamSpec::real("survival_probability", Dimension{},
-                      "JIPDA: keep each track's existence probability, a target surviving from one look to the next "
-                      "with this probability (default: JPDA, no existence)")
-          .positive()
-          .at_most(1),
+      association::initiation_threshold_param(),
+      association::survival_probability_param("JIPDA", "JPDA"),
       ParamSpec::integer("max_events", "a cluster with at most this many joint events is enumerated exactly; a larger "
                                        "one by the approximation (at most 1e7: about 0.1 s per cluster)")
           .def("10000")

@@ -2,6 +2,7 @@
 #include "association/assumed_sensor.hpp"
 #include "association/existence.hpp"
 #include "association/gated_pairs.hpp"
+#include "association/probabilistic_params.hpp"
 
 #include <trackflow/plugin.hpp>
 #include <trackflow/tracker.hpp>
@@ -107,18 +108,8 @@ void register_components(Registrar& r) {
       association::gate_probability_param(),
       association::AssumedSensor::detection_probability_param(),
       association::AssumedSensor::clutter_density_param(),
-      ParamSpec::real("initiation_threshold", Dimension{},
-                      "a detection whose probability of being some track's is at most this goes to the initiator "
-                      "(0: any detection in a gate starts no track)")
-          .def("0")
-          .at_least(0)
-          .at_most(1),
-      ParamSpec::real("survival_probability", Dimension{},
-                      "IPDA: keep each track's existence probability, a target surviving from one look to the next "
-                      "with this probability (Markov chain one); for init.existence and delete.existence (default: "
-                      "plain PDA, no existence)")
-          .positive()
-          .at_most(1),
+      association::initiation_threshold_param(),
+      association::survival_probability_param("IPDA", "PDA"),
   };
   d.create_part = create_part;
   r.add(std::move(d));

@@ -1,5 +1,6 @@
 // Purpose: tracker.multi — a multi-target tracker composed of parts: per scan it predicts every track, lets the associator give detections to tracks, updates (each track's own adapters around its updates), confirms and deletes (initiator, deleter), starts tracks from what no track took (initiator), and publishes one TrackSet.
 #include "association/gating.hpp"
+#include "association/scan_check.hpp"
 #include "memory/grow.hpp"
 
 #include <trackflow/component.hpp>
@@ -190,29 +191,8 @@ class MultiTracker final : public Component, public FieldListCodec<TrackerRunRes
   }
 
  private:
-  // A scan the estimator cannot take is a data error (the wiring was checked; the values are the data's).
   void check(const Scan& s) {
-    const MeasurementSpec& spec = prototype_->measurement_spec();
-    if (!(spec.frames & mask(s.sensor.frame)))
-      throw DataError("tracker.multi (node '" + node_ + "'): its estimator takes " + frame_names(spec.frames) +
-                      " detections, but the scan at t=" + std::to_string(s.time) + " s is " + to_string(s.sensor.frame));
-    if (!s.sensor.sensor_level && !spec.tilted_sensors)
-      throw DataError("tracker.multi (node '" + node_ + "'): the scan at t=" + std::to_string(s.time) +
-                      " s comes from a tilted sensor, which its estimator does not turn into");
-    // The estimator's own checks (Estimator::check) of the scan's first detection: what they test is
-    // the sensor's (a 2-D radar's tilt, say), which the scan's detections share.
-    if (!s.detections.empty()) {
-      to_measurement(s, s.detections.front(), m_);
-      prototype_->check(m_);
-    }
-    for (const Detection& d : s.detections) {
-      const int n = static_cast<int>(d.value.size());
-      if (n != position_values(s.sensor.frame) + (d.has_range_rate ? 1 : 0) || d.covariance.rows() != n || d.covariance.cols() != n ||
-          !d.value.allFinite() || !d.covariance.allFinite())
-        throw DataError("tracker.multi (node '" + node_ + "'): a detection of the scan at t=" + std::to_string(s.time) +
-                        " s has " + std::to_string(n) + " values and a " + std::to_string(d.covariance.rows()) + "x" +
-                        std::to_string(d.covariance.cols()) + " covariance, or non-finite ones");
-    }
+    association::check_scan(s, *prototype_, m_, "tracker.multi (node '" + node_ + "')");
   }
 
   int dimension(const SensorFrame& f, const Detection& d) const {

@@ -1,4 +1,5 @@
 // Purpose: tracker.tomht — a track-oriented multiple hypothesis tracker: target trees of track hypotheses, the k best global hypotheses per scan (Murty per cluster), N-scan pruning, score-based (SPRT) confirmation and deletion; publishes the best global hypothesis as one TrackSet per scan.
+#include "association/scan_check.hpp"
 #include "association/assumed_sensor.hpp"
 #include "association/gating.hpp"
 #include "tomht_engine.hpp"
@@ -127,27 +128,7 @@ class TomhtTracker final : public Component, public FieldListCodec<TomhtRunResul
   }
 
  private:
-  // A scan the estimator cannot take is a data error (as tracker.multi).
-  void check(const Scan& s) {
-    if (!(spec_.frames & mask(s.sensor.frame)))
-      throw DataError("tracker.tomht (node '" + node_ + "'): its estimator takes " + frame_names(spec_.frames) +
-                      " detections, but the scan at t=" + std::to_string(s.time) + " s is " + to_string(s.sensor.frame));
-    if (!s.sensor.sensor_level && !spec_.tilted_sensors)
-      throw DataError("tracker.tomht (node '" + node_ + "'): the scan at t=" + std::to_string(s.time) +
-                      " s comes from a tilted sensor, which its estimator does not turn into");
-    if (!s.detections.empty()) {
-      to_measurement(s, s.detections.front(), m_);
-      checker_->check(m_);
-    }
-    for (const Detection& d : s.detections) {
-      const int n = static_cast<int>(d.value.size());
-      if (n != position_values(s.sensor.frame) + (d.has_range_rate ? 1 : 0) || d.covariance.rows() != n ||
-          d.covariance.cols() != n || !d.value.allFinite() || !d.covariance.allFinite())
-        throw DataError("tracker.tomht (node '" + node_ + "'): a detection of the scan at t=" + std::to_string(s.time) +
-                        " s has " + std::to_string(n) + " values and a " + std::to_string(d.covariance.rows()) + "x" +
-                        std::to_string(d.covariance.cols()) + " covariance, or non-finite ones");
-    }
-  }
+  void check(const Scan& s) { association::check_scan(s, *checker_, m_, "tracker.tomht (node '" + node_ + "')"); }
 
   void report_warnings() {
     std::vector<std::string>& w = engine_.warnings();
