@@ -490,3 +490,39 @@ TEST_CASE("weighted updates: a sure detection is the plain update") {
     CHECK(after.state == before.state);
   }
 }
+
+// Estimator::copy_from: a spare made into a copy of another track's estimator runs on exactly as
+// that estimator does (as a clone would), and keeps its own binding; where it is not offered it
+// says so (false) and the caller clones.
+TEST_CASE("copy_from makes a spare run on as its original") {
+  int copied = 0;
+  for (const Case& c : cases()) {
+    INFO(c.type << " " << c.params);
+    auto e = test::fixture().make_estimator(c.type, c.params);
+    auto spare = test::fixture().make_estimator(c.type, c.params);
+    const auto ms = track(c.frame, 60);
+    Track t, ts;
+    run(*e, t, std::vector<Measurement>(ms.begin(), ms.begin() + 30), [](const Measurement&) {}, [](const Measurement&, bool) {});
+    run(*spare, ts, std::vector<Measurement>(ms.begin() + 40, ms.end()), [](const Measurement&) {}, [](const Measurement&, bool) {});
+    if (!spare->copy_from(*e)) continue;
+    ++copied;
+    ts = t;
+    ts.estimate = &ts.e;
+    for (const Measurement& m : std::vector<Measurement>(ms.begin() + 30, ms.begin() + 40)) {
+      const double T = m.time - t.time;
+      t.time = ts.time = m.time;
+      e->measurement_noise() = spare->measurement_noise() = m.covariance;
+      e->predict(T);
+      spare->predict(T);
+      const int dim = static_cast<int>(m.value.size());
+      REQUIRE(e->update(m, dim) == spare->update(m, dim));
+    }
+    Estimate a, b;
+    e->fill(a);
+    spare->fill(b);
+    CHECK(a.state == b.state);
+    CHECK(a.covariance == b.covariance);
+    CHECK(ts.e.nis == t.e.nis);  // the spare reported to its own track
+  }
+  CHECK(copied >= 7);  // filter.kalman, filter.ekf, filter.ukf cases
+}

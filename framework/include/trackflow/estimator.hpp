@@ -149,6 +149,12 @@ class Estimator {
     return combined_by_moments(detections, probability, none, dim);
   }
 
+  // Optional: make this estimator a copy of `other` (the same concrete type, state included) in
+  // place, without allocating — a tracker that branches tracks (tracker.tomht) reuses its spare
+  // estimators instead of cloning one per branch. Binding (bind()) stays this estimator's. false:
+  // another type, or this estimator cannot; the caller clones instead.
+  virtual bool copy_from(const Estimator& /*other*/) { return false; }
+
   const MeasurementSpec& measurement_spec() const { return spec_; }
   void bind(TrackContext& track) { track_ = &track; }
   MeasCov& measurement_noise() { return R_; }
@@ -220,6 +226,19 @@ class Estimator {
     wrap_residual(s.frame, p.z);
     p.S = innovation.innovation_covariance;
     return set_log_det(p);
+  }
+
+  // copy_from by the concrete type's copy assignment (Self: the concrete estimator, whose members
+  // copy into storage of the same size without allocating: fixed-size Eigen, strings and lists
+  // of the same configuration); the track binding is kept.
+  template <class Self>
+  bool copy_by_assignment(const Estimator& other) {
+    const auto* o = dynamic_cast<const Self*>(&other);
+    if (!o) return false;
+    TrackContext* const keep = track_;
+    static_cast<Self&>(*this) = *o;
+    track_ = keep;
+    return true;
   }
 
   // The moment-matched mixture of update_weighted through this estimator's own update() and

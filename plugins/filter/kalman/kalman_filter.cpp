@@ -194,6 +194,7 @@ class KalmanEstimator final : public Estimator {
     return true;
   }
   bool takes_weighted_updates() const override { return true; }
+  bool copy_from(const Estimator& other) override { return copy_by_assignment<KalmanEstimator>(other); }
 
  private:
 

@@ -98,6 +98,7 @@ class CartesianRadarEstimator : public Estimator, protected CartesianRadarState<
     return true;
   }
   bool takes_weighted_updates() const override { return true; }
+  bool copy_from(const Estimator& other) override { return this->template copy_by_assignment<Derived>(other); }
 
  protected:
   explicit CartesianRadarEstimator(Settings s)

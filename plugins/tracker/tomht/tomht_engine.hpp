@@ -261,6 +261,19 @@ class Engine {
     e.bind(context_);
   }
 
+  // A copy of a leaf's estimator for its child: a spare made into the copy in place
+  // (Estimator::copy_from), so a steady population allocates nothing; a clone when no spare is
+  // left or the estimator cannot copy in place.
+  std::unique_ptr<Estimator> copy_of(const Estimator& parent) {
+    if (!spare_.empty()) {
+      std::unique_ptr<Estimator> e = std::move(spare_.back());
+      spare_.pop_back();
+      if (e->copy_from(parent)) return e;
+      spare_.push_back(std::move(e));
+    }
+    return parent.clone();
+  }
+
   std::unique_ptr<Estimator> fresh() {
     if (spare_.empty()) return prototype_->clone();
     std::unique_ptr<Estimator> e = std::move(spare_.back());
@@ -318,7 +331,7 @@ class Engine {
       for (; p < pairs.size() && pairs[p].track == static_cast<int>(i); ++p) {
         const association::GatedPair& g = pairs[p];
         const Detection& d = s.detections[static_cast<std::size_t>(g.detection)];
-        std::unique_ptr<Estimator> e = l.estimator->clone();
+        std::unique_ptr<Estimator> e = copy_of(*l.estimator);
         bind(*e, s.time);
         const int dim = dimension(s.sensor, d);
         e->measurement_noise() = d.covariance.topLeftCorner(dim, dim);
