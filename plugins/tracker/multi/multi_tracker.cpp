@@ -642,7 +642,7 @@ std::unique_ptr<Component> create(const Params& p) {
       throw ConfigError("the associator " + p.component("associator").type +
                             " gives association probabilities, so each track is updated with all its candidate "
                             "detections at once (Estimator::update_weighted), which " + estimator_entry.type +
-                            " cannot: take filter.kalman, filter.ekf, filter.ukf or filter.imm (with modes:)",
+                            " cannot: take filter.kalman, filter.ekf, filter.ukf or filter.imm",
                         estimator_entry.type_where, p.node());
     if (!p.components("adapters").empty())
       throw p.error("adapters", "per-track adapters see one detection per update; the associator " +
