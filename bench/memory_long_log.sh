@@ -5,10 +5,11 @@
 #   ROWS       data rows of the generated log (default 10000000, about 370 MB of CSV)
 #   REPEATS    runs of each case; the median max RSS is printed with every value (default 1)
 # Env: LONG_LOG_DIR=DIR keeps the generated log in DIR (reused when it has ROWS rows) instead of a
-# temporary folder; METRICS_ROWS=N also scores an N-row log with sink.metrics, series: false
-# (default ROWS, the same log; 0: skip). Needs GNU time (Debian package `time`) and python3. The
-# limits are 150 MB without and 100 MB with sink.metrics (docs/performance.md, "Memory flat in
-# the length of a recorded log", issue 20 point 7).
+# temporary folder; METRICS_ROWS=N also scores an N-row log with sink.metrics, series: false,
+# then with sink.metrics' defaults (series: true) (default ROWS, the same log; 0: skip). Needs GNU
+# time (Debian package `time`) and python3. The limits are 150 MB without and 100 MB with
+# sink.metrics (docs/performance.md, "Memory flat in the length of a recorded log", issue 20
+# point 7, issue 27).
 set -eu
 cd "$(dirname "$0")/.."
 TF=${1:-build/bin/trackflow}
@@ -82,6 +83,10 @@ if [ "$METRICS_ROWS" -gt 0 ]; then
     make_log "$METRICS_ROWS" "$METRICS_LOG"
   fi
   pipeline "$METRICS_LOG" "  - { id: score, type: sink.metrics, inputs: [kf], params: { series: false } }" > "$OUT/metrics.yaml"
-  measure "$METRICS_ROWS-row log + sink.metrics, 2 runs, --threads 2 (limit 100 MB)" \
+  measure "$METRICS_ROWS-row log + sink.metrics series: false, 2 runs, --threads 2 (limit 100 MB)" \
     "$TF" run "$OUT/metrics.yaml" --threads 2 --no-progress --out "$OUT/o3"
+  # With its defaults (series: true, issue 27's case) the series is kept in at most 16 384 bins.
+  pipeline "$METRICS_LOG" "  - { id: score, type: sink.metrics, inputs: [kf] }" > "$OUT/metrics_series.yaml"
+  measure "$METRICS_ROWS-row log + sink.metrics (defaults), 2 runs, --threads 2 (limit 100 MB)" \
+    "$TF" run "$OUT/metrics_series.yaml" --threads 2 --no-progress --out "$OUT/o4"
 fi

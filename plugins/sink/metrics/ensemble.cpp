@@ -56,6 +56,55 @@ void insert_steps(StepList& steps, std::vector<long long>& missing) {
 
 }  // namespace
 
+void Ensemble::add_bins(const std::vector<SeriesBin>& run_bins, long long width) {
+  if (width > bin_width) {
+    if (bin_width > 0) coarsen(bins, width);
+    bin_width = width;
+  }
+  const std::vector<SeriesBin>* from = &run_bins;
+  if (width < bin_width) {
+    bin_scratch_ = run_bins;
+    coarsen(bin_scratch_, bin_width);
+    from = &bin_scratch_;
+  }
+  // Both lists are in key order: one merge (a run's bins usually are the ensemble's, in order).
+  std::vector<SeriesBin> merged;
+  std::size_t i = 0;
+  bool in_place = true;
+  for (const SeriesBin& b : *from) {
+    while (i < bins.size() && bins[i].key < b.key) ++i;
+    if (i == bins.size() || bins[i].key != b.key) {
+      in_place = false;
+      break;
+    }
+  }
+  if (in_place) {
+    i = 0;
+    for (const SeriesBin& b : *from) {
+      while (bins[i].key < b.key) ++i;
+      add_step_sums(bins[i].sums, b.sums);
+    }
+  } else {
+    merged.reserve(bins.size() + from->size());
+    i = 0;
+    for (const SeriesBin& b : *from) {
+      while (i < bins.size() && bins[i].key < b.key) merged.push_back(bins[i++]);
+      if (i < bins.size() && bins[i].key == b.key) {
+        merged.push_back(bins[i++]);
+      } else {
+        merged.emplace_back().key = b.key;
+      }
+      add_step_sums(merged.back().sums, b.sums);
+    }
+    while (i < bins.size()) merged.push_back(bins[i++]);
+    bins.swap(merged);
+  }
+  while (bins.size() > kMaxSeriesBins) {
+    bin_width *= 2;
+    coarsen(bins, bin_width);
+  }
+}
+
 void Ensemble::add(const MetricsRunResult& run) {
   ++runs;
   runs_with_truth += run.had_truth ? 1 : 0;
@@ -67,6 +116,7 @@ void Ensemble::add(const MetricsRunResult& run) {
   measurements_matched += run.measurements_matched;
   measurements_unmatched += run.measurements_unmatched;
   if (run.sums.used) add_sums(run.sums);
+  if (run.series_bin_width > 0) add_bins(run.series_bins, run.series_bin_width);
   // Steps this run reaches for the first time are created before anything is added, so every
   // step's sums grow in run order and, within a run, in record order (estimates, then
   // measurements), as with a map.
@@ -201,9 +251,9 @@ void report_anis(const Ensemble& e, const ReportOptions& opt, Summary& s) {
     total = e.summed_anis;
     n = e.summed_nis_steps;
     if (n && e.summed_steps_differ)
-      s.notes.push_back("anis: the runs differ in their time steps or innovation dimensions, and without truth and "
-                        "series no per-step table is kept, so anis is the mean over every run's steps (steps: the "
-                        "most of one run); series: true gives the per-step ensemble mean");
+      s.notes.push_back("anis: the runs differ in their time steps or innovation dimensions, and a streaming run "
+                        "without truth keeps no per-step table, so anis is the mean over every run's steps (steps: "
+                        "the most of one run)");
   }
   if (n == 0) {
     s.notes.push_back("anis not reported: no updated estimate carries an innovation");

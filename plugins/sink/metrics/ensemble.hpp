@@ -2,6 +2,7 @@
 #pragma once
 
 #include "annotation_channels.hpp"
+#include "step_sums.hpp"
 
 #include <trackflow/component.hpp>
 #include <trackflow/run_result_codec.hpp>
@@ -78,6 +79,10 @@ struct MetricsRunResult final : RunResult {
   double measurement_sq_error = 0.0;
   std::uint64_t measurements_matched = 0, measurements_unmatched = 0;
   RunSums sums;
+  // Streaming runs without truth with series: the run's per-step series, binned (series_bin_width
+  // time keys a bin; 0: not used, the series comes from `records`).
+  std::vector<SeriesBin> series_bins;
+  long long series_bin_width = 0;
   // Streaming runs: the most estimates that waited for their truth at once (tests, diagnostics).
   std::uint64_t pending_high_water = 0;
   // A run's records as bytes and back, exactly (mpirun: run_result_codec.hpp's FieldListCodec);
@@ -86,25 +91,10 @@ struct MetricsRunResult final : RunResult {
   static void fields(Self& r, F&& f) {
     f(r.records, r.measurement_records, r.had_truth, r.before_window, r.non_finite, r.unmatched,
       r.not_positive_definite, r.measurement_sq_error, r.measurements_matched, r.measurements_unmatched, r.sums,
-      r.pending_high_water);
+      r.series_bins, r.series_bin_width, r.pending_high_water);
   }
 };
 
-struct StepSums {
-  double time = 0.0;  // of the first run that reached this step
-  bool has_time = false;
-  std::uint64_t published = 0, initialised = 0, updated = 0;  // estimates of any kind
-  AnnotationSums annotations;
-  std::uint64_t measurements = 0;
-  double measurement_sq = 0.0;
-  std::uint64_t estimates = 0, matched = 0;  // scored estimates
-  double sq[6] = {};   // sum of squared errors per ENU component
-  double sum[6] = {};  // sum of errors (bias)
-  std::uint64_t nees_count = 0;
-  double nees = 0.0, nees_position = 0.0;
-  std::uint64_t nis_count = 0, nis_dof = 0;
-  double nis = 0.0;
-};
 
 // The time steps in key order (as a std::map iterates them), in one array: a run's records find
 // their step from the previous record's (records come in time order), with no tree to walk.
@@ -127,11 +117,16 @@ struct Ensemble {
   double summed_anis = 0.0;
   std::uint64_t summed_steps = 0, summed_nis_steps = 0, summed_nis_dof = 0, summed_nis_count = 0;
   std::uint64_t summed_fingerprint = 0;
+  // The binned series of such runs (SeriesBin), merged in run order at the widest run's width.
+  std::vector<SeriesBin> bins;
+  long long bin_width = 0;
 
   void add(const MetricsRunResult& run);
 
  private:
   void add_sums(const RunSums& r);
+  void add_bins(const std::vector<SeriesBin>& run_bins, long long width);
+  std::vector<SeriesBin> bin_scratch_;
   std::vector<long long> missing_;  // add()'s scratch: keys of the run not yet in steps
 };
 

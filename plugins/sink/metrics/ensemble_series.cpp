@@ -26,9 +26,12 @@ class BandCache {
   std::map<std::uint64_t, Band> cache_;
 };
 
-}  // namespace
+const StepSums& sums_of(const std::pair<long long, StepSums>& step) { return step.second; }
+const StepSums& sums_of(const SeriesBin& bin) { return bin.sums; }
 
-Series ensemble_series(const Ensemble& e, const ReportOptions& opt, const AnnotationChannels& channels) {
+// One row per entry of `rows`: the ensemble's time steps, or (a run without truth) its bins.
+template <class Rows>
+Series series_of(const Ensemble& e, const Rows& rows, const ReportOptions& opt, const AnnotationChannels& channels) {
   Series s;
   s.name = "ensemble";
   s.description = "per time step over the runs: RMSE, mean error, ANEES/ANIS with their " +
@@ -54,7 +57,7 @@ Series ensemble_series(const Ensemble& e, const ReportOptions& opt, const Annota
   std::vector<int> used;
   for (int c = 0; c < channels.count() && c < kMaxAnnotations; ++c) {
     bool any = false;
-    for (const auto& [key, st] : e.steps) any = any || st.annotations.count[c] > 0;
+    for (const auto& row : rows) any = any || sums_of(row).annotations.count[c] > 0;
     if (any) {
       used.push_back(c);
       s.add_column(channels.name(c) + "_mean", channels.unit(c));
@@ -63,8 +66,12 @@ Series ensemble_series(const Ensemble& e, const ReportOptions& opt, const Annota
 
   BandCache nees_bands(opt.confidence), nis_bands(opt.confidence);
   const double runs = static_cast<double>(e.runs);
-  s.values.reserve(e.steps.size() * s.columns.size());
-  for (const auto& [key, st] : e.steps) {
+  s.values.reserve(rows.size() * s.columns.size());
+  // A bin of several steps: its fractions are over the (run, step) pairs it holds.
+  const bool binned = e.bin_width > 1;
+  for (const auto& row : rows) {
+    const StepSums& st = sums_of(row);
+    const double runs_here = binned ? static_cast<double>(st.run_steps) : runs;
     auto put = [&](double v) { s.values.push_back(v); };
     put(st.time);
     put(static_cast<double>(st.matched));
@@ -97,11 +104,17 @@ Series ensemble_series(const Ensemble& e, const ReportOptions& opt, const Annota
       for (int i = 0; i < 3; ++i) put(kNaN);
     }
     put(st.measurements ? std::sqrt(st.measurement_sq / static_cast<double>(st.measurements)) : kNaN);
-    put(runs > 0 ? static_cast<double>(st.initialised) / runs : kNaN);
-    put(runs > 0 ? static_cast<double>(st.updated) / runs : kNaN);
+    put(runs_here > 0 ? static_cast<double>(st.initialised) / runs_here : kNaN);
+    put(runs_here > 0 ? static_cast<double>(st.updated) / runs_here : kNaN);
     for (int c : used) put(st.annotations.mean(c));
   }
   return s;
+}
+
+}  // namespace
+
+Series ensemble_series(const Ensemble& e, const ReportOptions& opt, const AnnotationChannels& channels) {
+  return e.bin_width > 0 ? series_of(e, e.bins, opt, channels) : series_of(e, e.steps, opt, channels);
 }
 
 }  // namespace trackflow::metrics

@@ -5,6 +5,7 @@
 #include "scoring/truth_match.hpp"
 
 #include <trackflow/geometry.hpp>
+#include <trackflow/number_text.hpp>
 #include <trackflow/plugin.hpp>
 #include <trackflow/run_result_codec.hpp>
 
@@ -27,7 +28,7 @@ enum class SameTime { All, Last };
 
 // When every input is time-ordered (InputInfo::time_ordered) a run is scored as it arrives
 // (stream_scorer.hpp): an estimate as soon as its truth is certain, so only those still waiting
-// for truth are kept, and without truth or series nothing per step. Otherwise items are stored
+// for truth are kept, and without truth nothing per estimate (the series in bounded bins). Otherwise items are stored
 // during the run and everything is evaluated in end_run(), when the truth of the whole run is
 // known (truth of a time step may arrive after the estimate of that step, and out of order).
 // Both give the same records; they cross processes under mpirun by MetricsRunResult's field
@@ -62,7 +63,7 @@ class MetricsSink final : public Component, public FieldListCodec<MetricsRunResu
     streaming_ = streaming;
     if (streaming_)
       scorer_.configure({skip_initial_, tolerance_, series_, last_at_time_, truth_input_, estimate_inputs > 0,
-                         measurement_input_, !truth_input_ && !series_},
+                         measurement_input_, !truth_input_},
                         &channels_);
     if (estimate_inputs > 1)
       throw ConfigError("inputs " + estimate_sources +
@@ -156,6 +157,11 @@ class MetricsSink final : public Component, public FieldListCodec<MetricsRunResu
     const metrics::ReportOptions opt{confidence_, skip_initial_, truth_input_, measurement_input_};
     metrics::report(ensemble_, opt, summary);
     if (series_ && ensemble_.runs > 0) summary.series.push_back(metrics::ensemble_series(ensemble_, opt, channels_));
+    if (series_ && ensemble_.bin_width > 1)
+      summary.notes.push_back("series: " + std::to_string(ensemble_.bins.size()) + " rows, each the mean over " +
+                              number_text::general(static_cast<double>(ensemble_.bin_width) * tolerance_, 6) +
+                              " s of the runs' steps (a run without truth keeps at most " +
+                              std::to_string(metrics::kMaxSeriesBins) + " series rows in memory)");
   }
 
  private:
@@ -242,9 +248,10 @@ void register_components(Registrar& r) {
       "likewise with the innovation dimension. Without truth (recorded logs) only anis, mean_innovation_<i> "
       "and counts are reported. Only initialised estimates are scored. When every input is time-ordered (its "
       "sources declare so, e.g. sim.trajectory, source.csv) a run is scored as it arrives: an estimate as soon as "
-      "its truth is certain, with only those still waiting for truth kept; without truth and with series: false "
-      "nothing is kept per step, and anis is summed per run (the same mean when the runs share their time steps, "
-      "else a note). Per time step it also publishes the "
+      "its truth is certain, with only those still waiting for truth kept; without truth nothing is kept per "
+      "estimate, anis is summed per run (the same mean when the runs share their time steps, else a note), and "
+      "the series is kept in at most 16384 rows: a longer log's rows are means over bins of 2^k time_tolerance "
+      "seconds (said in a note), so memory stays flat however long the log. Per time step it also publishes the "
       "ensemble series (`trackflow run --series`, `trackflow report`): position/velocity RMSE, mean error per axis, "
       "ANEES and ANIS with the band for the runs at that step, measurement RMSE, fractions of runs initialised and "
       "updated, and the mean of each adapter annotation (e.g. quality grades, adapted sigmas); the series' mean ANEES "

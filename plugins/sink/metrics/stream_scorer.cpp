@@ -36,6 +36,7 @@ void StreamScorer::start_run() {
   }
   run_ = std::make_unique<MetricsRunResult>();
   if (!opt_.sums_only) run_->records.reserve(records_reserve_);
+  if (opt_.sums_only && opt_.series) run_->series_bins.reserve(bins_reserve_);
   // The series' measurement records likewise: grown from empty in every run, they were the hot
   // path's only allocations (and copies) after the first run.
   if (opt_.series) run_->measurement_records.reserve(measurement_records_reserve_);
@@ -53,6 +54,7 @@ void StreamScorer::start_run() {
   before_start_.clear();
   estimate_cursor_ = measurement_cursor_ = cursor_base_ = nullptr;
   step_open_ = false;
+  bin_step_open_ = false;
 }
 
 void StreamScorer::on_truth(const Truth& t) {
@@ -97,15 +99,35 @@ void StreamScorer::commit(const Estimate& e) {
   }
   const long long key = round_key(e.time / opt_.tolerance);
   EstimateRecord* rec = nullptr;
+  StepSums* bin = nullptr;  // sums_only with series: what Ensemble::add would add for a record
   if (!opt_.sums_only) {
     rec = &r.records.emplace_back();
     rec->key = key;
     rec->time = e.time;
     rec->initialised = e.initialised;
     rec->updated = e.initialised && e.updated;
+  } else if (opt_.series) {
+    bin = &series_bin(r.series_bins, r.series_bin_width, key);
+    if (!bin_step_open_ || key != bin_step_key_) {
+      ++bin->run_steps;
+      bin_step_open_ = true;
+      bin_step_key_ = key;
+    }
+    if (!bin->has_time) {
+      bin->time = e.time;
+      bin->has_time = true;
+    }
+    ++bin->published;
+    bin->initialised += e.initialised ? 1 : 0;
+    bin->updated += e.initialised && e.updated ? 1 : 0;
   }
   if (!e.initialised) return;
   if (rec && opt_.series) channels_->read(e, rec->annotation);
+  if (bin) {
+    float annotation[kMaxAnnotations];
+    channels_->read(e, annotation);
+    bin->annotations.add(annotation, channels_->count());
+  }
   if (e.time + opt_.tolerance < start_) {
     ++r.before_window;
     return;
@@ -117,6 +139,15 @@ void StreamScorer::commit(const Estimate& e) {
   if (opt_.sums_only) {  // no truth input: every scored estimate is unmatched, as in the stored path
     add_to_step(key, e.updated, e.nis, e.innovation);
     ++r.unmatched;
+    if (bin) {
+      ++bin->estimates;
+      const int m = static_cast<int>(e.innovation.size());
+      if (e.updated && m > 0 && std::isfinite(e.nis)) {
+        ++bin->nis_count;
+        bin->nis_dof += static_cast<std::uint64_t>(m);
+        bin->nis += e.nis;
+      }
+    }
     return;
   }
   score_innovation(*rec, e.updated, e.nis, e.innovation);
@@ -318,6 +349,7 @@ std::unique_ptr<MetricsRunResult> StreamScorer::end_run() {
   }
   r.had_truth = truth_seen_;
   records_reserve_ = r.records.size();  // runs are usually of one length
+  bins_reserve_ = r.series_bins.size();
   measurement_records_reserve_ = r.measurement_records.size();
   return std::move(run_);
 }

@@ -48,7 +48,8 @@ struct StreamOptions {
   bool series = false;        // records of every estimate, uninitialised ones too (per-step series)
   bool last_at_time = false;  // same_time: last
   bool truth_input = false, estimate_input = false, measurement_input = false;
-  // No truth input and no series: the run keeps RunSums only, nothing per estimate or step.
+  // No truth input: the run keeps RunSums only, nothing per estimate, and with series its
+  // per-step series in bounded bins (ensemble.hpp, SeriesBin).
   bool sums_only = false;
 };
 
@@ -106,6 +107,7 @@ class StreamScorer {
   std::unique_ptr<MetricsRunResult> run_;
   std::size_t records_reserve_ = 1024;  // the previous run's record count
   std::size_t measurement_records_reserve_ = 1024;  // and measurement record count (series)
+  std::size_t bins_reserve_ = 1024;                 // and series bin count (sums_only with series)
   std::uint64_t run_count_ = 0;
 
   // Truth of the run, sorted as insert_truth keeps it; with one target, only from what a lookup
@@ -137,6 +139,9 @@ class StreamScorer {
   long long step_key_ = 0;
   double step_nis_ = 0.0;
   std::uint64_t step_dof_ = 0, step_count_ = 0;
+  // sums_only with series: the time step whose (run, step) pair was last counted in its bin.
+  bool bin_step_open_ = false;
+  long long bin_step_key_ = 0;
 };
 
 }  // namespace trackflow::metrics

@@ -573,3 +573,121 @@ TEST_CASE("streaming matches stored with several truth targets") {
     }
   }
 }
+
+namespace {
+
+// A run of a recorded log without truth: `steps` updated estimates 0.1 s apart whose NIS equals
+// its dimension (3), so every step's and every bin's ANIS is exactly 1.
+void feed_log(Component& c, int steps) {
+  for (int k = 0; k < steps; ++k) {
+    Estimate e = estimate(0.1 * k, state(100.0 * k, 0, 0));
+    e.updated = true;
+    e.innovation = MeasVec::Constant(3, 1.0);
+    e.nis = 3.0;
+    c.on_estimate(e, 0);
+  }
+}
+
+std::size_t column(const Series& s, const std::string& name) {
+  for (std::size_t i = 0; i < s.columns.size(); ++i)
+    if (s.columns[i].name == name) return i;
+  FAIL("no column " << name);
+  return 0;
+}
+
+}  // namespace
+
+// Without truth, series: true keeps no per-estimate record either (issue 27: a 10^6-row log scored
+// in flat memory): a short log's series is the stored path's, row for row; the summary is the
+// run sums' (the same mean, summed in another order).
+TEST_CASE("no truth with series: bins equal the stored steps") {
+  const std::vector<InputInfo> inputs{kFilter, kConverted};
+  auto feed = [](Component& c, int r) { feed_run(c, r, 2000, 0, 0); };
+  const Summary stored = run_ensemble("{}", inputs, 3, feed);
+  const Summary streamed = run_streaming("{}", inputs, 3, feed);
+  CHECK(value(streamed, "anis") == Approx(value(stored, "anis")).epsilon(1e-12));
+  CHECK(value(streamed, "steps") == value(stored, "steps"));
+  REQUIRE(stored.series.size() == 1);
+  REQUIRE(streamed.series.size() == 1);
+  const Series &a = stored.series[0], &b = streamed.series[0];
+  REQUIRE(a.columns.size() == b.columns.size());
+  REQUIRE(a.values.size() == b.values.size());
+  for (std::size_t j = 0; j < a.values.size(); ++j) {
+    const double x = a.values[j], y = b.values[j];
+    INFO("value " << j << " (column " << a.columns[j % a.columns.size()].name << ")");
+    CHECK(((std::isnan(x) && std::isnan(y)) || y == Approx(x).epsilon(1e-12)));
+  }
+  CHECK_FALSE(has_note(streamed, "series:"));
+}
+
+// A log longer than kMaxSeriesBins steps: the run holds at most that many bins, whose widths are
+// powers of two; the series' rows are bin means (every ANIS 1, every fraction 1), and a note says so.
+TEST_CASE("no truth: a long log keeps a bounded binned series") {
+  const std::vector<InputInfo> inputs{kFilter, kConverted};
+  const int steps = 5 * static_cast<int>(metrics::kMaxSeriesBins) + 123;
+  {
+    auto worker = test::make("sink.metrics", "{}", "score");
+    worker->set_inputs({ordered(kFilter), ordered(kConverted)});
+    Diagnostics diag;
+    worker->start_run({0, 7, &diag});
+    feed_log(*worker, steps);
+    auto result = worker->end_run();
+    const auto& r = static_cast<const metrics::MetricsRunResult&>(*result);
+    CHECK(r.records.empty());
+    CHECK(r.series_bins.size() <= metrics::kMaxSeriesBins);
+    CHECK(r.series_bins.size() > metrics::kMaxSeriesBins / 8);
+    CHECK((r.series_bin_width & (r.series_bin_width - 1)) == 0);
+    std::uint64_t published = 0, run_steps = 0;
+    for (const auto& b : r.series_bins) {
+      CHECK(b.key % r.series_bin_width == 0);
+      published += b.sums.published;
+      run_steps += b.sums.run_steps;
+    }
+    CHECK(published == static_cast<std::uint64_t>(steps));
+    CHECK(run_steps == static_cast<std::uint64_t>(steps));
+  }
+  // Runs of different lengths (different widths) merge at the widest.
+  const Summary s = run_streaming("{}", inputs, 3, [&](Component& c, int r) { feed_log(c, r == 1 ? steps : 500); });
+  CHECK(value(s, "anis") == Approx(1.0).epsilon(1e-12));
+  CHECK(value(s, "steps") == steps);
+  REQUIRE(s.series.size() == 1);
+  const Series& e = s.series[0];
+  const std::size_t rows = e.values.size() / e.columns.size();
+  CHECK(rows <= metrics::kMaxSeriesBins);
+  CHECK(rows > metrics::kMaxSeriesBins / 8);
+  const std::size_t anis = column(e, "anis"), init = column(e, "initialised_fraction"), time = column(e, "time");
+  double last = -1.0;
+  for (std::size_t k = 0; k < rows; ++k) {
+    const double* row = &e.values[k * e.columns.size()];
+    CHECK(row[anis] == Approx(1.0).epsilon(1e-12));
+    CHECK(row[init] == 1.0);
+    CHECK(row[time] > last);
+    last = row[time];
+  }
+  CHECK(has_note(s, "series: " + std::to_string(rows) + " rows, each the mean over"));
+}
+
+// The bins' arithmetic: floor keys before time 0, and coarsening keeps every sum.
+TEST_CASE("series bins: keys floor and coarsening keeps the sums") {
+  CHECK(metrics::bin_key(-1, 4) == -4);
+  CHECK(metrics::bin_key(-4, 4) == -4);
+  CHECK(metrics::bin_key(7, 4) == 4);
+  CHECK(metrics::bin_key(7, 1) == 7);
+  std::vector<metrics::SeriesBin> bins;
+  long long width = 1;
+  for (long long k = -50000; k < 50000; ++k) {
+    metrics::StepSums& s = metrics::series_bin(bins, width, 3 * k);
+    ++s.published;
+    s.nis += 0.5;
+  }
+  CHECK(bins.size() <= metrics::kMaxSeriesBins);
+  double nis = 0.0;
+  std::uint64_t published = 0;
+  for (std::size_t i = 0; i < bins.size(); ++i) {
+    if (i) CHECK(bins[i].key == bins[i - 1].key + width);
+    nis += bins[i].sums.nis;
+    published += bins[i].sums.published;
+  }
+  CHECK(published == 100000);
+  CHECK(nis == 50000.0);
+}
