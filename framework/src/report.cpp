@@ -5,6 +5,7 @@
 
 #include <nlohmann/json.hpp>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -82,8 +83,30 @@ std::vector<ExpectResult> check_expects(const Graph& g, const Outcome& out) {
       comparable = comparable && std::isfinite(ref.value);
       r.text = name + (less ? " < " : " > ") + e.ref_node + "." + e.ref_metric + " = " + fmt(ref.value);
     } else if (e.op == "within_band" || e.op == "outside_band") {
-      if (!m->has_band)
-        throw ConfigError("expect: metric '" + e.metric + "' of '" + e.node + "' has no band; use min/max", e.loc);
+      if (!m->has_band) {
+        // A metric that may lack its band in a run where its test has no power (sink.metrics:
+        // "<metric>: no band: ..." or "...: no acceptance: ..." in the notes) fails the check:
+        // the claim cannot be verified from this run. Any other band-less metric is a mistake.
+        const NodeOutcome* node = out.find(e.node);
+        const std::string prefix = e.metric + ": no ";
+        const auto note = std::find_if(node->summary.notes.begin(), node->summary.notes.end(),
+                                       [&](const std::string& n) { return n.rfind(prefix, 0) == 0; });
+        if (note != node->summary.notes.end()) {
+          r.passed = false;
+          r.text = name + " has no band in this run (" + *note + ")";
+          results.push_back(std::move(r));
+          continue;
+        }
+        // sink.metrics' mean ANEES has no band (issue 25): its verdict is the per-step test.
+        const std::string per_step = e.metric + "_steps_in_band";
+        const Metric* steps = node->summary.find(per_step);
+        const bool has_per_step = steps && steps->has_band;
+        throw ConfigError("expect: metric '" + e.metric + "' of '" + e.node + "' has no band; use min/max" +
+                              (has_per_step ? " (its consistency verdict is the per-step test: " + e.node + "." +
+                                                  per_step + ": { " + e.op + ": " + fmt(e.value) + " })"
+                                            : std::string()),
+                          e.loc);
+      }
       if (std::fabs(m->confidence - e.value) > 1e-9)
         throw ConfigError("expect asks for a " + fmt(e.value * 100) + " % band, but '" + e.node + "' computes its " +
                               e.metric + " band at " + fmt(m->confidence * 100) + " % (set its 'confidence' param)",

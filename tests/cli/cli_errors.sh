@@ -96,7 +96,7 @@ expect_run "an expect naming a missing metric is a config error" 2 "has no metri
 { base; printf 'expect:\n  score.position_rmse: { less_than: score.velocity_rmsee }\n'; } > "$TMP/expect_ref.yaml"
 expect_run "a less_than reference to a missing metric is a config error" 2 "has no metric 'velocity_rmsee' \(did you mean 'velocity_rmse'\?\)" \
   -- "$TF" run "$TMP/expect_ref.yaml" --out "$TMP/out"
-{ base; printf 'expect:\n  score.position_rmse: { greater_than: score.velocity_rmse }\n  score.anees: { outside_band: 0.95 }\n'; } > "$TMP/expect_cmp.yaml"
+{ base; printf 'expect:\n  score.position_rmse: { greater_than: score.velocity_rmse }\n  score.anees_steps_in_band: { outside_band: 0.95 }\n'; } > "$TMP/expect_cmp.yaml"
 expect_run "greater_than and outside_band are evaluated" 1 "score.position_rmse = [0-9.]+ > score.velocity_rmse = [0-9.]+" \
   -- "$TF" run "$TMP/expect_cmp.yaml" --out "$TMP/out"
 # A dotted --set reaches into a component-valued parameter (tracker.multi's estimator, associator, ...).

@@ -52,8 +52,9 @@ echo "ok: quickstart ANEES series: $(cat "$TMP/anees.txt")"
 checks=$((checks + 1))
 
 # --- the series are identical for any thread count ------------------------------------------
-"$TF" run "$Q" --runs 12 --threads 1 --series --no-progress --out "$TMP/t1" > /dev/null 2>&1 || fail "run --threads 1"
-"$TF" run "$Q" --runs 12 --threads 2 --series --no-progress --out "$TMP/t2" > /dev/null 2>&1 || fail "run --threads 2"
+# (12 runs: the quickstart's expect block, made for 200, may fail: exit 1 is fine here.)
+"$TF" run "$Q" --runs 12 --threads 1 --series --no-progress --out "$TMP/t1" > /dev/null 2>&1; [ $? -le 1 ] || fail "run --threads 1"
+"$TF" run "$Q" --runs 12 --threads 2 --series --no-progress --out "$TMP/t2" > /dev/null 2>&1; [ $? -le 1 ] || fail "run --threads 2"
 cmp "$TMP/t1/score.ensemble.csv" "$TMP/t2/score.ensemble.csv" || fail "series differ between 1 and 2 threads"
 echo "ok: series identical with 1 and 2 threads"
 checks=$((checks + 1))
@@ -62,8 +63,9 @@ checks=$((checks + 1))
 J=$(tr -d ' \n' < "$TMP/qs.json")
 grep -q '"position_rmse":{"value":[0-9.e-]*,"unit":"m"}' <<< "$J" || fail "position_rmse lacks its unit: $J"
 grep -q '"velocity_rmse":{"value":[0-9.e-]*,"unit":"m/s"}' <<< "$J" || fail "velocity_rmse lacks its unit"
-grep -q '"anees":{"value":[0-9.e-]*,"unit":"","band_lo":[0-9.e-]*,"band_hi":[0-9.e-]*,"confidence":0.95}' <<< "$J" ||
-  fail "anees lacks its band"
+grep -q '"anees_steps_in_band":{"value":[0-9.e-]*,"unit":"","band_lo":[0-9.e-]*,"band_hi":1.0,"confidence":0.95}' <<< "$J" ||
+  fail "anees_steps_in_band lacks its band"
+grep -q '"anees":{"value":[0-9.e-]*,"unit":""}' <<< "$J" || fail "anees (the mean) has a band: it has none (issue 25)"
 echo "ok: metrics JSON carries units and bands"
 checks=$((checks + 1))
 

@@ -55,6 +55,8 @@ struct RunSums {
   std::uint64_t steps = 0;       // time steps with a scored estimate
   std::uint64_t nis_steps = 0;   // time steps with an innovation
   double anis_sum = 0.0;         // sum over those steps of (sum of NIS) / (sum of dof)
+  std::uint64_t nis_steps_in_band = 0;  // of those steps, inside their own one-run chi-square band
+  double inverse_dof = 0.0;             // sum over those steps of 1 / (sum of dof): the average's band
   std::uint64_t nis_dof = 0, nis_count = 0;
   double innovation_sum[kMaxMeasDim] = {};
   std::uint64_t innovation_count[kMaxMeasDim] = {};
@@ -62,7 +64,7 @@ struct RunSums {
   std::uint64_t fingerprint = 0;  // of every step's key, dof sum and whether it has a scored estimate
   template <class Self, class F>
   static void fields(Self& s, F&& f) {
-    f(s.used, s.scored, s.steps, s.nis_steps, s.anis_sum, s.nis_dof, s.nis_count, s.innovation_sum,
+    f(s.used, s.scored, s.steps, s.nis_steps, s.anis_sum, s.nis_steps_in_band, s.inverse_dof, s.nis_dof, s.nis_count, s.innovation_sum,
       s.innovation_count, s.nis_dof_min, s.nis_dof_max, s.fingerprint);
   }
 };
@@ -116,6 +118,8 @@ struct Ensemble {
   bool summed = false, summed_steps_differ = false;
   double summed_anis = 0.0;
   std::uint64_t summed_steps = 0, summed_nis_steps = 0, summed_nis_dof = 0, summed_nis_count = 0;
+  std::uint64_t summed_nis_steps_in_band = 0;
+  double summed_inverse_dof = 0.0;
   std::uint64_t summed_fingerprint = 0;
   // The binned series of such runs (SeriesBin), merged in run order at the widest run's width.
   std::vector<SeriesBin> bins;

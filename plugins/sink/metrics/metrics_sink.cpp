@@ -62,7 +62,7 @@ class MetricsSink final : public Component, public FieldListCodec<MetricsRunResu
     }
     streaming_ = streaming;
     if (streaming_)
-      scorer_.configure({skip_initial_, tolerance_, series_, last_at_time_, truth_input_, estimate_inputs > 0,
+      scorer_.configure({skip_initial_, tolerance_, confidence_, series_, last_at_time_, truth_input_, estimate_inputs > 0,
                          measurement_input_, !truth_input_},
                         &channels_);
     if (estimate_inputs > 1)
@@ -243,9 +243,13 @@ void register_components(Registrar& r) {
       "RMSE baseline and rmse_ratio), e.g. inputs: [kf, truth, cm]. Estimates are matched to truth at the same "
       "time (within time_tolerance) or by linear interpolation between truth samples; estimates outside the "
       "truth's time span are counted as unmatched_estimates. ANEES_k = sum over runs of NEES / (n M) per time "
-      "step (n = 6, or 3 for anees_position); anees is its mean over steps, with the per-step band "
-      "[chi2inv((1-c)/2, nM), chi2inv((1+c)/2, nM)]/(nM) (Bar-Shalom, Li & Kirubarajan 2001 §5.4.2). ANIS "
-      "likewise with the innovation dimension. Without truth (recorded logs) only anis, mean_innovation_<i> "
+      "step (n = 6, or 3 for anees_position), inside its per-step band "
+      "[chi2inv((1-c)/2, nM), chi2inv((1+c)/2, nM)]/(nM) when consistent (Bar-Shalom, Li & Kirubarajan 2001 "
+      "§5.4.2). The verdict is the per-step test: anees_steps_in_band, the fraction of steps inside their band, "
+      "against the binomial acceptance for the effective number of independent steps (anees_effective_steps: "
+      "the errors are correlated in time); anees, the mean over steps, has no band. ANIS likewise with the "
+      "innovation dimension, whose steps are independent when consistent, so anis also gets the band of the mean "
+      "(docs/report.md, Consistency tests). Without truth (recorded logs) only anis, mean_innovation_<i> "
       "and counts are reported. Only initialised estimates are scored. When every input is time-ordered (its "
       "sources declare so, e.g. sim.trajectory, source.csv) a run is scored as it arrives: an estimate as soon as "
       "its truth is certain, with only those still waiting for truth kept; without truth nothing is kept per "

@@ -2,6 +2,7 @@
 #include "stream_scorer.hpp"
 
 #include "record_scoring.hpp"
+#include "scoring/chi_square_band.hpp"
 #include "scoring/truth_match.hpp"
 
 #include <algorithm>
@@ -322,13 +323,25 @@ void StreamScorer::close_step() {
   RunSums& s = run_->sums;
   ++s.steps;
   if (step_count_) {
-    s.anis_sum += step_nis_ / static_cast<double>(step_dof_);
+    const double anis = step_nis_ / static_cast<double>(step_dof_);
+    s.anis_sum += anis;
+    s.inverse_dof += 1.0 / static_cast<double>(step_dof_);
     ++s.nis_steps;
+    const Band& band = one_run_band(step_dof_);
+    s.nis_steps_in_band += anis >= band.lo && anis <= band.hi ? 1 : 0;
     s.nis_dof += step_dof_;
     s.nis_count += step_count_;
   }
   s.fingerprint = mix(mix(s.fingerprint, static_cast<std::uint64_t>(step_key_)), step_dof_);
   step_open_ = false;
+}
+
+// The chi-square band of one step's summed innovation dimensions, cached: a quantile costs
+// microseconds and a run's steps share a few dimensions.
+const Band& StreamScorer::one_run_band(std::uint64_t dof) {
+  for (const auto& [d, band] : bands_)
+    if (d == dof) return band;
+  return bands_.emplace_back(dof, chi_square_band(static_cast<double>(dof), opt_.confidence)).second;
 }
 
 std::unique_ptr<MetricsRunResult> StreamScorer::end_run() {

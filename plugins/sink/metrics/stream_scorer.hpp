@@ -3,6 +3,7 @@
 
 #include "annotation_channels.hpp"
 #include "ensemble.hpp"
+#include "scoring/chi_square_band.hpp"
 
 #include <trackflow/items.hpp>
 
@@ -45,6 +46,7 @@ class Fifo {
 
 struct StreamOptions {
   double skip_initial = 0.0, tolerance = 1e-6;
+  double confidence = 0.95;   // of the per-step bands (sums_only's steps in band)
   bool series = false;        // records of every estimate, uninitialised ones too (per-step series)
   bool last_at_time = false;  // same_time: last
   bool truth_input = false, estimate_input = false, measurement_input = false;
@@ -101,6 +103,7 @@ class StreamScorer {
   void prune_truth();
   void add_to_step(long long key, bool updated, double nis, const MeasVec& innovation);
   void close_step();
+  const Band& one_run_band(std::uint64_t dof);
 
   StreamOptions opt_;
   const AnnotationChannels* channels_ = nullptr;
@@ -140,6 +143,7 @@ class StreamScorer {
   double step_nis_ = 0.0;
   std::uint64_t step_dof_ = 0, step_count_ = 0;
   // sums_only with series: the time step whose (run, step) pair was last counted in its bin.
+  std::vector<std::pair<std::uint64_t, Band>> bands_;  // one_run_band's cache
   bool bin_step_open_ = false;
   long long bin_step_key_ = 0;
 };
