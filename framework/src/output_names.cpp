@@ -3,6 +3,7 @@
 
 #include <trackflow/error.hpp>
 #include <trackflow/host/suggest.hpp>
+#include <trackflow/safe_output.hpp>
 
 #include <filesystem>
 #include <optional>
@@ -66,7 +67,7 @@ void check_run_outputs(const Graph& g, const RunOutputs& o) {
     std::string what, path;
   };
   std::vector<Named> cli;
-  if (!o.report.empty()) cli.push_back({"the report (--report)", resolved(o.report)});
+  if (!o.report.empty()) cli.push_back({"the report", resolved(o.report)});
   if (!o.metrics_json.empty()) cli.push_back({"--metrics-json", resolved(o.metrics_json)});
   if (cli.size() == 2 && cli[0].path == cli[1].path)
     throw ConfigError("--report and --metrics-json both name '" + quote_token(o.report, 300) + "'; give them different files");
@@ -74,14 +75,19 @@ void check_run_outputs(const Graph& g, const RunOutputs& o) {
     const fs::path rel = fs::path(d.file).lexically_normal();
     const std::string file = (fs::path(out_resolved) / rel).lexically_normal().string();
     const std::string shown = (out / rel).string();
+    // A symlinked folder on the way (out/<name>/sub -> ..) is refused now, not after run 0
+    // (SafeOutputFile refuses it again when the file is opened).
+    if (!rel.has_root_path() && rel.parent_path().has_filename() && *rel.begin() != "..")
+      if (std::string why = linked_folder_problem(out.string(), rel.parent_path().string()); !why.empty())
+        refuse(g, d.node, "cannot write '" + quote_token(shown, 300) + "': " + why);
     for (const auto& c : cli)
       if (c.path == file)
-        refuse(g, d.node, "node '" + d.node + "' writes '" + quote_token(shown, 300) + "', the file of " + c.what +
+        refuse(g, d.node, "its file '" + quote_token(shown, 300) + "' is also the file of " + c.what +
                               "; give one of them another name");
     if (!o.series || fs::path(file).parent_path() != fs::path(out_resolved)) continue;
     if (auto owner = series_owner(g, rel.filename().string()))
-      refuse(g, d.node, "node '" + d.node + "' writes '" + quote_token(shown, 300) + "', a name of the series files of node '" +
-                            *owner + "' (--series writes <node>.<series>.csv into --out); give it another 'path'");
+      refuse(g, d.node, "its file '" + quote_token(shown, 300) + "' is a name of the series files of node '" + *owner +
+                            "' (--series writes <node>.<series>.csv into --out); give it another 'path'");
   }
   // The report or --metrics-json at the top of --out under a series file's name.
   if (o.series)

@@ -51,7 +51,7 @@ checks=$((checks + 1))
 { base; printf '  - { id: log, type: sink.csv, inputs: [kf, truth], params: { path: sub/t.csv } }\n'; } > "$REPO/sub.yaml"
 ln -s .. "$REPO/out/hostile/sub"
 before=$(outside_sums repo/out/hostile)
-expect_run "path: sub/t.csv with sub -> .. inside --out is refused" 2 "out/hostile/sub' is a symbolic link" \
+expect_run "path: sub/t.csv with sub -> .. inside --out is refused" 2 "node 'log': cannot write 'out/hostile/sub/t.csv': 'out/hostile/sub' is a symbolic link" \
   -- bash -c "cd '$REPO' && '$TF' run sub.yaml"
 rm "$REPO/out/hostile/sub"
 ln -s "$TMP/victims/elsewhere" "$REPO/out/hostile/sub"
@@ -105,14 +105,14 @@ expect_run "... and at run" 2 "nodes 'a' and 'b' both write 'a.csv'" -- "$TF" ru
 expect_run "... also when spelled differently" 2 "both write 'a.csv'" -- "$TF" validate "$TMP/twice2.yaml"
 { base; printf '  - { id: log, type: sink.csv, inputs: [kf], params: { path: report.html } }\n'; } > "$TMP/rep.yaml"
 expect_run "a sink.csv path equal to the default report is refused before the runs" 2 \
-  "node 'log' writes '$TMP/c2/report.html', the file of the report" -- "$TF" report "$TMP/rep.yaml" --out "$TMP/c2"
-expect_run "... and to --report" 2 "node 'log' writes .*, the file of the report" \
+  "node 'log': its file '$TMP/c2/report.html' is also the file of the report" -- "$TF" report "$TMP/rep.yaml" --out "$TMP/c2"
+expect_run "... and to --report" 2 "node 'log': its file .* is also the file of the report; give one of them another name" \
   -- "$TF" run "$TMP/rep.yaml" --out "$TMP/c3" --report "$TMP/c3/report.html"
-expect_run "a sink.csv path equal to --metrics-json is refused" 2 "node 'log' writes .*report.html', the file of --metrics-json" \
+expect_run "a sink.csv path equal to --metrics-json is refused" 2 "node 'log': its file .*report.html' is also the file of --metrics-json" \
   -- "$TF" run "$TMP/rep.yaml" --out "$TMP/c4" --metrics-json "$TMP/c4/report.html"
 { base; printf '  - { id: log, type: sink.csv, inputs: [kf], params: { path: score.ensemble.csv } }\n'; } > "$TMP/ser.yaml"
 expect_run "a sink.csv path equal to a series file is refused with --series" 2 \
-  "node 'log' writes .*score.ensemble.csv', a name of the series files of node 'score'" -- "$TF" run "$TMP/ser.yaml" --out "$TMP/c5" --series
+  "node 'log': its file .*score.ensemble.csv' is a name of the series files of node 'score'" -- "$TF" run "$TMP/ser.yaml" --out "$TMP/c5" --series
 expect_run "--report equal to --metrics-json is refused" 2 "--report and --metrics-json both name" \
   -- "$TF" run "$TMP/p.yaml" --out "$TMP/c6" --report "$TMP/x.html" --metrics-json "$TMP/x.html"
 for d in c1 c2 c3 c4 c5 c6; do [ -e "$TMP/$d" ] && [ -n "$(ls -A "$TMP/$d")" ] && fail "a refused run wrote into $d: $(ls -A "$TMP/$d")"; done

@@ -23,7 +23,8 @@ struct RunOutputs {
 // A sink's file equal to the report, to --metrics-json, or to a series file name
 // (<node id>.<anything>.csv at the top of --out, for a node of this pipeline: series names are
 // known only after the runs, the node id before them), and the report equal to --metrics-json:
-// a ConfigError naming both and the file. Paths are compared after resolving the symlinks of
+// a ConfigError naming both and the file; also a sink's path through a symlinked folder
+// beneath --out (linked_folder_problem, safe_output.hpp). Paths are compared after resolving the symlinks of
 // the folders that exist (a sink's folders beneath --out are never followed, safe_output.hpp).
 void check_run_outputs(const Graph& g, const RunOutputs& o);
 
