@@ -3,6 +3,10 @@
 
 #include <trackflow/host/suggest.hpp>
 #include <trackflow/output_path.hpp>
+#include <trackflow/safe_output.hpp>
+
+#include <fcntl.h>
+#include <sys/file.h>
 
 #include <unistd.h>
 
@@ -99,9 +103,36 @@ void check_output_file(const std::string& path, const std::string& option) {
   if (fs::is_directory(p, ec)) throw ConfigError(option + " '" + path + "' is a folder, not a file");
   if (fs::exists(p, ec)) {
     if (::access(p.c_str(), W_OK) != 0) throw ConfigError(option + " '" + path + "': " + std::strerror(errno));
-    return;
+  } else {
+    check_parent_writable(p.parent_path(), option, path);
   }
-  check_parent_writable(p.parent_path(), option, path);
+  // access() says yes to root in /proc: the temporary the file will be written through is
+  // created and removed here, so such a path is refused before the runs (safe_output.hpp).
+  if (std::string why = user_file_problem(path); !why.empty()) throw ConfigError(option + ": " + why);
+}
+
+OutputFolderLock::~OutputFolderLock() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void OutputFolderLock::hold(const std::string& path, const std::string& option, bool create) {
+  std::error_code ec;
+  if (create) fs::create_directories(path, ec);
+  const int fd = ::open(path.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
+  if (fd < 0) {
+    if (errno == ENOENT && !create) return;
+    throw ConfigError(option + " '" + path + "': cannot open the folder: " + std::strerror(errno));
+  }
+  if (::flock(fd, LOCK_EX | LOCK_NB) != 0) {
+    const int err = errno;
+    ::close(fd);
+    if (err == EWOULDBLOCK)
+      throw ConfigError(option + " '" + path + "' is in use by another running trackflow (it holds the folder until it "
+                        "ends); wait for it or choose another --out");
+    throw ConfigError(option + " '" + path + "': cannot lock the folder: " + std::strerror(err));
+  }
+  if (fd_ >= 0) ::close(fd_);
+  fd_ = fd;
 }
 
 void check_output_folder(const std::string& path, const std::string& option) {

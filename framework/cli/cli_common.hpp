@@ -40,9 +40,26 @@ void apply_trust(const Common& c);
 // and values beyond 64 bits are refused instead of wrapping.
 std::uint64_t parse_count(const std::string& text, const std::string& option, std::uint64_t min, std::uint64_t max);
 // Refuses, before anything runs, an output file (or folder) that cannot be written: a folder
-// where a file is wanted, a parent that is a file or not writable. Creates nothing.
+// where a file is wanted, a parent that is a file or not writable, a folder where its temporary
+// cannot be created (tried and removed again: /proc). Leaves nothing behind.
 void check_output_file(const std::string& path, const std::string& option);
 void check_output_folder(const std::string& path, const std::string& option);
+// Holds the --out folder for this process: flock(LOCK_EX | LOCK_NB) on the folder itself
+// (nothing is created for it; released at exit), so a second trackflow writing into the same
+// folder at the same time is refused (exit 2) instead of mixing the two runs' files. `create`:
+// make the folder first (it will be written); otherwise a missing folder is not held (the
+// unique temporaries of safe_output.hpp still keep each file whole).
+class OutputFolderLock {
+ public:
+  OutputFolderLock() = default;
+  OutputFolderLock(const OutputFolderLock&) = delete;
+  OutputFolderLock& operator=(const OutputFolderLock&) = delete;
+  ~OutputFolderLock();
+  void hold(const std::string& path, const std::string& option, bool create);
+
+ private:
+  int fd_ = -1;
+};
 void warn_problems(const host::PluginRegistry& reg);
 // Parses argv after the command word; prints help and returns false when asked.
 bool parse(int argc, char** argv, po::options_description& opts, po::positional_options_description& pos,

@@ -4,9 +4,11 @@
 
 #include <trackflow/host/engine.hpp>
 #include <trackflow/host/guard.hpp>
+#include <trackflow/host/output_names.hpp>
 #include <trackflow/host/report.hpp>
 #include <trackflow/host/suggest.hpp>
 #include <trackflow/host/validate.hpp>
+#include <trackflow/safe_output.hpp>
 #include <trackflow/version.hpp>
 
 #include <boost/program_options.hpp>
@@ -16,6 +18,7 @@
 
 #include <algorithm>
 #include <cerrno>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -164,10 +167,23 @@ int cmd_run(int argc, char** argv, bool report_mode = false) {
     throw ConfigError("--track-run " + std::to_string(track_run) + ": there are only " + std::to_string(ro.runs) +
                       " runs (0 to " + std::to_string(ro.runs - 1) + ")");
   // Every output is checked before the runs: a typo in a path must not cost the whole ensemble.
+  OutputFolderLock out_lock;
   if (is_root()) {
     if (!out_dir.empty() || series || want_report) check_output_folder(ro.output_dir, "--out");
     if (!metrics_json.empty()) check_output_file(metrics_json, "--metrics-json");
     if (!report_html.empty()) check_output_file(report_html, "--report");
+    check_run_outputs(l.graph, {ro.output_dir, series || report_mode,
+                                want_report && report_html.empty()
+                                    ? (std::filesystem::path(ro.output_dir) / "report.html").string()
+                                    : report_html,
+                                metrics_json});
+    // The default out/<name> is beneath the current folder, which a pipeline's repository may
+    // be: a link there (out -> ~) would move every file.
+    if (out_dir.empty())
+      if (std::string why = linked_folder_problem(".", ro.output_dir); !why.empty())
+        throw ConfigError("the default --out '" + ro.output_dir + "': " + why + " (pass --out to choose a folder)");
+    // Another trackflow writing into this --out now is refused (flock on the folder, held to the end).
+    out_lock.hold(ro.output_dir, "--out", !out_dir.empty() || series || want_report);
   }
   Outcome out = run_ensemble(l.graph, l.reg, ro);
   if (!is_root()) return kOk;  // rank 0 of the MPI job reports, checks and writes
@@ -177,6 +193,7 @@ int cmd_run(int argc, char** argv, bool report_mode = false) {
   if (series || report_mode) req.series_dir = ro.output_dir;
   if (want_report)
     req.html = report_html.empty() ? (std::filesystem::path(ro.output_dir) / "report.html").string() : report_html;
+  if (want_report && report_html.empty()) req.html_out = ro.output_dir;
   req.track_node = track_node;
   req.scene_node = scene_node;
   req.track_run = track_run;
@@ -442,6 +459,9 @@ int main(int argc, char** argv) {
   // TRACKFLOW_CRASH_HANDLER=0 leaves fatal signals to the system (a core dump for a debugger).
   const char* handler = std::getenv("TRACKFLOW_CRASH_HANDLER");
   if (!handler || std::string(handler) != "0") install_crash_handler();
+  // Past RLIMIT_FSIZE a write fails with EFBIG (reported, the temporary removed: safe_output.hpp)
+  // instead of SIGXFSZ killing the process with a truncated file left behind.
+  std::signal(SIGXFSZ, SIG_IGN);
   int rc = dispatch(argc, argv);
   // Whatever was printed must have reached its destination: a full disk is not a success.
   std::cout.flush();

@@ -4,6 +4,8 @@
 #include "html_report.hpp"
 #include "series_csv.hpp"
 
+#include <trackflow/safe_output.hpp>
+
 #include <filesystem>
 
 namespace trackflow::cli {
@@ -97,7 +99,9 @@ std::vector<std::string> write_report_outputs(const ReportRequest& req, const ho
     r.scene_node = req.scene_node;
     r.track_run = req.track_run;
     r.files = files;
-    report::write_text_file(req.html, report::render_run_report(r));
+    // The default name beneath --out is written as a sink's file is (no symlink followed there).
+    if (!req.html_out.empty()) write_file_beneath(req.html_out, "report.html", report::render_run_report(r));
+    else report::write_text_file(req.html, report::render_run_report(r));
     files.push_back(req.html);
   }
   return files;

@@ -25,6 +25,7 @@ std::string add_scene_recorder(host::PipelineConfig& cfg, const host::PluginRegi
 struct ReportRequest {
   std::string series_dir;  // write every node's series as CSV here ("" no)
   std::string html;        // write the HTML report here ("" no)
+  std::string html_out;    // non-empty: `html` is the default <--out>/report.html, written beneath this folder
   std::string track_node;  // the recorder added by add_track_recorder ("" none)
   std::string scene_node;  // the recorder added by add_scene_recorder ("" none)
   std::uint64_t track_run = 0;

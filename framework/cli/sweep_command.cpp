@@ -9,6 +9,7 @@
 #include <trackflow/host/suggest.hpp>
 #include <trackflow/host/sweep.hpp>
 #include <trackflow/number_text.hpp>
+#include <trackflow/safe_output.hpp>
 #include <trackflow/units.hpp>
 
 #include <unistd.h>
@@ -149,11 +150,18 @@ int cmd_sweep(int argc, char** argv) {
   });
   const std::string out_root =
       vm.count("out") ? vm["out"].as<std::string>() : (std::filesystem::path("out") / base.name).string();
-  // Outputs are checked before the grid runs.
+  // Outputs are checked before the grid runs; another trackflow writing into --out is refused.
+  OutputFolderLock out_lock;
   if (is_root()) {
     if (vm.count("out")) check_output_folder(out_root, "--out");
     if (!csv_path.empty()) check_output_file(csv_path, "--csv");
     if (!report_path.empty()) check_output_file(report_path, "--report");
+    // Neither the default out/<name> nor the sweep-<i> folders trackflow names are followed
+    // through a link (safe_output.hpp).
+    std::string why = vm.count("out") ? std::string() : linked_folder_problem(".", out_root);
+    for (size_t i = 0; i < grid.size() && why.empty(); ++i) why = linked_folder_problem(out_root, "sweep-" + std::to_string(i));
+    if (!why.empty()) throw ConfigError("--out '" + out_root + "': " + why);
+    out_lock.hold(out_root, "--out", vm.count("out") > 0);
   }
 
   std::vector<host::Outcome> outcomes(grid.size());

@@ -6,6 +6,7 @@
 #include "report_assets.hpp"
 
 #include <trackflow/number_text.hpp>
+#include <trackflow/safe_output.hpp>
 #include <trackflow/version.hpp>
 
 #include <algorithm>
@@ -688,15 +689,6 @@ std::string render_sweep_report(const SweepReport& r) {
   return page.finish(g.config.name + " - trackflow sweep report");
 }
 
-void write_text_file(const std::string& path, const std::string& text) {
-  const auto parent = std::filesystem::path(path).parent_path();
-  std::error_code ec;
-  if (!parent.empty()) std::filesystem::create_directories(parent, ec);
-  std::ofstream f(path, std::ios::binary | std::ios::trunc);
-  if (!f) throw ConfigError("cannot write '" + path + "': " + std::strerror(errno));
-  f << text;
-  f.close();  // a full disk shows at the flush
-  if (f.fail()) throw ConfigError("cannot write '" + path + "': " + std::strerror(errno));
-}
+void write_text_file(const std::string& path, const std::string& text) { write_user_file(path, text); }
 
 }  // namespace trackflow::report

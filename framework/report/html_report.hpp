@@ -47,7 +47,8 @@ struct SweepReport {
 
 std::string render_sweep_report(const SweepReport& r);
 
-// Writes `text` to `path` (folders created); ConfigError naming the path on failure.
+// Writes `text` to `path` (folders created) through a temporary renamed into place
+// (safe_output.hpp: a command-line path); ConfigError naming the path on failure.
 void write_text_file(const std::string& path, const std::string& text);
 
 }  // namespace trackflow::report

@@ -4,15 +4,16 @@
 #include "csv_text.hpp"
 
 #include <trackflow/error.hpp>
+#include <trackflow/safe_output.hpp>
 
 #include <cerrno>
 #include <cstring>
 #include <filesystem>
-#include <fstream>
 
 namespace trackflow::report {
 
-void write_series_csv(const std::string& path, const Series& s) {
+namespace {
+std::string series_text(const Series& s) {
   std::string text;
   for (size_t c = 0; c < s.columns.size(); ++c)
     text += (c ? "," : "") + csv_field(column_header(s.columns[c].name, s.columns[c].unit));
@@ -25,13 +26,18 @@ void write_series_csv(const std::string& path, const Series& s) {
     }
     text += '\n';
   }
-  const auto parent = std::filesystem::path(path).parent_path();
-  std::error_code ec;
-  if (!parent.empty()) std::filesystem::create_directories(parent, ec);
-  std::ofstream f(path, std::ios::binary | std::ios::trunc);
-  f << text;
-  f.flush();
-  if (!f) throw ConfigError("cannot write series file '" + path + "': " + std::strerror(errno));
+  return text;
+}
+
+// A temporary renamed into place (safe_output.hpp): a full disk leaves no truncated series file.
+void fail_series(const SafeOutputFile& f) {
+  throw ConfigError("cannot write series file '" + f.path() + "': " + std::strerror(f.error_number()));
+}
+}  // namespace
+
+void write_series_csv(const std::string& path, const Series& s) {
+  SafeOutputFile f;
+  if (!f.open_user_path(path) || !f.write(series_text(s)) || !f.commit()) fail_series(f);
 }
 
 std::string series_file_name(const std::string& node, const Series& s) {
@@ -45,9 +51,10 @@ std::vector<std::string> write_all_series(const std::string& dir, const host::Ou
   std::vector<std::string> files;
   for (const auto& n : out.nodes)
     for (const auto& s : n.summary.series) {
-      const std::string path = (std::filesystem::path(dir) / series_file_name(n.id, s)).string();
-      write_series_csv(path, s);
-      files.push_back(path);
+      // Beneath --out: never written through a symlink a pipeline's repository put there.
+      SafeOutputFile f;
+      if (!f.open_beneath(dir, series_file_name(n.id, s)) || !f.write(series_text(s)) || !f.commit()) fail_series(f);
+      files.push_back(f.path());
     }
   return files;
 }

@@ -2,6 +2,7 @@
 #include <trackflow/host/graph.hpp>
 #include <trackflow/host/filter_control.hpp>
 #include <trackflow/host/guard.hpp>
+#include <trackflow/host/output_names.hpp>
 #include <trackflow/host/suggest.hpp>
 #include <trackflow/host/validate.hpp>
 #include <trackflow/track_adapters.hpp>
@@ -213,8 +214,19 @@ Graph build_graph(PipelineConfig cfg, const PluginRegistry& registry) {
                         e.loc);
     }
 
-  // Plugin-side checks (segment consistency, data files) run at construction.
-  (void)instantiate(g, registry);
+  // Plugin-side checks (segment consistency, data files) run at construction; the files the
+  // sinks declare then are checked for collisions (output_names.hpp).
+  std::vector<DeclaredOutput> declared;
+  collect_declared_outputs(&declared);
+  try {
+    (void)instantiate(g, registry);
+  } catch (...) {
+    collect_declared_outputs(nullptr);
+    throw;
+  }
+  collect_declared_outputs(nullptr);
+  g.outputs = std::move(declared);
+  check_declared_outputs(g);
   return g;
 }
 

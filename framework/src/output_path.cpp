@@ -7,7 +7,16 @@
 namespace trackflow {
 namespace {
 std::atomic<bool> g_outside_allowed{false};
+// Per thread: build_graph instantiates on the calling thread, while worker threads constructing
+// their own copies of the graph declare into nothing.
+thread_local std::vector<DeclaredOutput>* t_declared = nullptr;
+}  // namespace
+
+void declare_output_file(const std::string& node, const std::string& relative_path) {
+  if (t_declared) t_declared->push_back({node, relative_path});
 }
+
+void collect_declared_outputs(std::vector<DeclaredOutput>* into) { t_declared = into; }
 
 std::string output_path_problem(const std::string& path) {
   if (g_outside_allowed.load()) return {};

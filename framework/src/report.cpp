@@ -2,6 +2,7 @@
 #include <trackflow/host/report.hpp>
 #include <trackflow/host/suggest.hpp>
 #include <trackflow/number_text.hpp>
+#include <trackflow/safe_output.hpp>
 
 #include <nlohmann/json.hpp>
 
@@ -179,9 +180,6 @@ void print_summary(std::ostream& os, const Graph& g, const Outcome& out, unsigne
 // Each metric as an object with its unit (and band), written by nlohmann::json: NaN or
 // infinity become null, strings are escaped by the library.
 void write_metrics_json(const std::string& path, const Outcome& out) {
-  const std::filesystem::path parent = std::filesystem::path(path).parent_path();
-  std::error_code ec;
-  if (!parent.empty()) std::filesystem::create_directories(parent, ec);
   nlohmann::ordered_json j = nlohmann::ordered_json::object();
   for (const auto& n : out.nodes) {
     if (n.summary.metrics.empty() && n.skips == 0) continue;
@@ -201,11 +199,11 @@ void write_metrics_json(const std::string& path, const Outcome& out) {
   // Node ids are ASCII, but metric names come from plugins: invalid UTF-8 becomes U+FFFD rather
   // than an exception or an invalid file.
   const std::string text = j.dump(2, ' ', false, nlohmann::ordered_json::error_handler_t::replace) + "\n";
-  std::ofstream f(path, std::ios::binary | std::ios::trunc);
-  if (!f) throw ConfigError("cannot write metrics JSON '" + path + "': " + std::strerror(errno));
-  f << text;
-  f.close();  // a full disk shows at the flush
-  if (f.fail()) throw ConfigError("error writing metrics JSON '" + path + "': " + std::strerror(errno));
+  // Through a temporary renamed into place (safe_output.hpp): a full disk leaves no truncated file.
+  SafeOutputFile f;
+  if (!f.open_user_path(path)) throw ConfigError("cannot write metrics JSON '" + path + "': " + std::strerror(f.error_number()));
+  if (!f.write(text) || !f.commit())
+    throw ConfigError("error writing metrics JSON '" + path + "': " + std::strerror(f.error_number()));
 }
 
 }  // namespace trackflow::host

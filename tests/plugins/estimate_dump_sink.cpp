@@ -1,6 +1,7 @@
 // Purpose: test.estimate_dump — a test-only sink that writes a filter's full published output (state, state covariance, innovation, NIS, annotations) at 17 significant digits, for the reference-output regression test (tests/reference).
 #include <trackflow/plugin.hpp>
 #include <trackflow/run_result_codec.hpp>
+#include <trackflow/safe_output.hpp>
 
 #include <cerrno>
 #include <cstdio>
@@ -76,15 +77,13 @@ class EstimateDump final : public Component, public FieldListCodec<DumpRunResult
   void merge(RunResult& r) override { file_ += static_cast<DumpRunResult&>(r).rows; }
 
   void finish(Summary& s, const FinishContext& ctx) override {
-    namespace fs = std::filesystem;
-    const fs::path dir(ctx.output_dir.empty() ? "." : ctx.output_dir);
-    std::error_code ec;
-    fs::create_directories(dir, ec);
-    const fs::path file = dir / (ctx.node + ".csv");
-    std::ofstream os(file, std::ios::binary | std::ios::trunc);
-    os << "# run,step,time,initialised,updated,n,x[n],P[i<=j],m,nu[m],nis,k,annotations[k]\n" << file_;
-    if (!os) throw ConfigError("cannot write '" + file.string() + "': " + std::strerror(errno), {}, ctx.node);
-    s.files.push_back(file.string());
+    // As every sink's file: beneath --out without following links, renamed when whole.
+    SafeOutputFile f;
+    if (!f.open_beneath(ctx.output_dir.empty() ? "." : ctx.output_dir, ctx.node + ".csv") ||
+        !f.write("# run,step,time,initialised,updated,n,x[n],P[i<=j],m,nu[m],nis,k,annotations[k]\n") || !f.write(file_) ||
+        !f.commit())
+      throw ConfigError(f.error(), {}, ctx.node);
+    s.files.push_back(f.path());
   }
 
  private:

@@ -5,6 +5,7 @@
 #include <trackflow/output_path.hpp>
 #include <trackflow/plugin.hpp>
 #include <trackflow/run_result_codec.hpp>
+#include <trackflow/safe_output.hpp>
 #include <trackflow/scan.hpp>
 #include <trackflow/tracks.hpp>
 
@@ -149,18 +150,15 @@ class CsvSink final : public Component, public RunResultCodec {
     // A pipeline file from someone else must not write anywhere but under --out.
     if (std::string why = output_path_problem(path_); !why.empty())
       throw p.error("path", why + " (pass --allow-outside-out on the command line to allow it)");
+    // Checked by the host against the run's other outputs (two sinks, the report, series files).
+    declare_output_file(node_, path_.empty() ? node_ + ".csv" : path_);
     truth_.reserve(4096);
     pending_.reserve(1024);
   }
 
-  ~CsvSink() override {
-    // An ensemble that did not finish leaves no half-written file under the real name.
-    if (out_) {
-      std::fclose(out_);
-      std::error_code ec;
-      std::filesystem::remove(partial_, ec);
-    }
-  }
+  // An ensemble that did not finish leaves no half-written file under the real name: the
+  // temporary of out_ (safe_output.hpp) is removed by its destructor.
+  ~CsvSink() override = default;
 
   void set_inputs(const std::vector<InputInfo>& inputs) override {
     sources_.clear();
@@ -386,8 +384,8 @@ class CsvSink final : public Component, public RunResultCodec {
     non_finite_total_ += r.non_finite;
     // Streamed in run order into the file while the ensemble runs (the engine tells every
     // thread the output folder), so memory does not grow with the ensemble.
-    if (!out_ && !output_directory().empty()) open(output_directory());
-    if (out_) {
+    if (!out_.is_open() && !output_directory().empty()) open(output_directory());
+    if (out_.is_open()) {
       if (r.spilled) append_file(r.spilled->f);
       put(r.rows.data(), r.rows.size());
     } else {
@@ -401,20 +399,10 @@ class CsvSink final : public Component, public RunResultCodec {
   }
 
   void finish(Summary& summary, const FinishContext& ctx) override {
-    if (!out_) open(ctx.output_dir);
+    if (!out_.is_open()) open(ctx.output_dir);
     put(file_.data(), file_.size());
     file_.clear();
-    if (std::fflush(out_) != 0 || std::ferror(out_)) fail_write(errno);
-    std::FILE* f = out_;
-    out_ = nullptr;
-    if (std::fclose(f) != 0) fail_write(errno);
-    std::error_code ec;
-    std::filesystem::rename(partial_, file_path_, ec);
-    if (ec) {
-      std::filesystem::remove(partial_, ec);
-      throw ConfigError("cannot write '" + file_path_.string() + "': " + ec.message() + " (check 'path' and --out)",
-                        path_where_, ctx.node);
-    }
+    if (!out_.commit()) fail_write();
     summary.files.push_back(file_path_.string());
     summary.metric("rows", static_cast<double>(total_rows_));
     if (total_rows_ == 0) summary.notes.push_back("no rows: no initialised estimate" +
@@ -432,20 +420,10 @@ class CsvSink final : public Component, public RunResultCodec {
   void open(const std::string& output_dir) {
     namespace fs = std::filesystem;
     file_path_ = fs::path(output_dir.empty() ? "." : output_dir) / (path_.empty() ? node_ + ".csv" : path_);
-    partial_ = file_path_;
-    partial_ += ".partial";
-    std::error_code ec;
-    if (file_path_.has_parent_path()) fs::create_directories(file_path_.parent_path(), ec);
-    if (ec)
-      throw ConfigError("cannot create the folder '" + file_path_.parent_path().string() + "': " + ec.message(),
-                        path_where_, node_);
-    if (fs::is_directory(file_path_, ec))
-      throw ConfigError("cannot write '" + file_path_.string() + "': it is a folder (check 'path' and --out)",
-                        path_where_, node_);
-    out_ = std::fopen(partial_.c_str(), "wb");
-    if (!out_)
-      throw ConfigError("cannot write '" + partial_.string() + "': " + std::strerror(errno) + " (check 'path' and --out)",
-                        path_where_, node_);
+    // Folders beneath --out opened without following symlinks, a unique temporary renamed
+    // into place at finish (safe_output.hpp, issue 27).
+    if (!out_.open_beneath(output_dir.empty() ? "." : output_dir, path_.empty() ? node_ + ".csv" : path_))
+      throw ConfigError(out_.error() + " (check 'path' and --out)", path_where_, node_);
     std::string header = kHeader;
     if (tracks_input_) header += kTrackHeader;
     if (scans_input_) header += kOriginHeader;
@@ -456,7 +434,7 @@ class CsvSink final : public Component, public RunResultCodec {
   }
 
   void put(const char* data, std::size_t n) {
-    if (n && std::fwrite(data, 1, n, out_) != n) fail_write(errno);
+    if (!out_.write(data, n)) fail_write();
   }
 
   void append_file(std::FILE* in) {
@@ -467,10 +445,8 @@ class CsvSink final : public Component, public RunResultCodec {
   }
 
   // A full disk is an error of the run, found when it happens, not a file silently cut short.
-  [[noreturn]] void fail_write(int err) {
-    throw ConfigError("cannot write '" + file_path_.string() + "': " + std::strerror(err ? err : EIO) +
-                          " (check the space on the disk, 'path' and --out)",
-                      path_where_, node_);
+  [[noreturn]] void fail_write() {
+    throw ConfigError(out_.error() + " (check the space on the disk, 'path' and --out)", path_where_, node_);
   }
 
   // Moves the rows of this run to a temporary file in the output folder when they outgrow
@@ -645,8 +621,8 @@ class CsvSink final : public Component, public RunResultCodec {
   std::string first_non_finite_;
   // Aggregating instance.
   std::string file_;  // rows merged while no output folder was known (direct use)
-  std::FILE* out_ = nullptr;
-  std::filesystem::path file_path_, partial_;
+  SafeOutputFile out_;
+  std::filesystem::path file_path_;
   std::uint64_t total_rows_ = 0;
   std::uint64_t non_finite_total_ = 0;
   std::string first_non_finite_total_;
@@ -671,8 +647,8 @@ void register_components(Registrar& r) {
       "its origin target only, and one more column, origin: the target id, clutter, or empty when unknown. Truth "
       "columns and nees are filled when a truth sample lies within 1 us of the row's time, nis when the estimate "
       "was updated; missing values are empty cells, and a value that is NaN or infinite is written as nan, inf or -inf "
-      "and fails the run (exit 2). The file is streamed in run order while the ensemble runs (written as <file>.partial, "
-      "renamed when complete). With full_covariance: true, 21 more columns hold the upper "
+      "and fails the run (exit 2). The file is streamed in run order while the ensemble runs (written as a temporary .<file>.<pid>.<random>.partial, "
+      "renamed when complete; folders beneath --out are never followed through symbolic links). With full_covariance: true, 21 more columns hold the upper "
       "triangle of the ENU covariance row by row (x y z vx vy vz; m2, m2/s, m2/s2; Cartesian measurement rows: their "
       "position block). "
       "Measurement rows carry the Cartesian position (spherical ones converted) and, when Cartesian, the sigmas "

@@ -3,6 +3,7 @@
 
 #include <trackflow/host/config.hpp>
 #include <trackflow/host/plugins.hpp>
+#include <trackflow/output_path.hpp>
 
 #include <memory>
 #include <string>
@@ -23,6 +24,7 @@ struct Graph {
   PipelineConfig config;
   std::vector<GraphNode> nodes;
   std::vector<int> order;    // topological: every node after its inputs
+  std::vector<DeclaredOutput> outputs;  // the files the nodes declared at construction (output_path.hpp)
 };
 
 // Collects nothing silently: the first problem is thrown as a ConfigError naming file:line:col
