@@ -113,7 +113,7 @@ TEST_CASE("scene picture: a track's colour depends on its id only") {
   CHECK(std::string(track_colour(0)) == "#1f77b4");
 }
 
-TEST_CASE("JSON in the report's script element has no '<', '>' or '&' and reads back the same") {
+TEST_CASE("script-safe JSON has no < > or & and parses back the same") {
   const nlohmann::json j = {{"label", "imm.p_<!--<script>"}, {"t", "</script><b>&amp;-->"}, {"path", "a\\<b"}};
   const std::string safe = script_safe_json(j.dump());
   CHECK(safe.find('<') == std::string::npos);
