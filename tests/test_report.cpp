@@ -2,9 +2,11 @@
 #include "charts.hpp"
 #include "csv_text.hpp"
 #include "report_assets.hpp"
+#include "script_json.hpp"
 #include "series_csv.hpp"
 
 #include <catch2/catch.hpp>
+#include <nlohmann/json.hpp>
 
 #include <cmath>
 #include <filesystem>
@@ -109,4 +111,13 @@ TEST_CASE("scene picture: a track's colour depends on its id only") {
   CHECK(std::string(track_colour(3)) == track_colour(13));
   CHECK(std::string(track_colour(3)) != track_colour(4));
   CHECK(std::string(track_colour(0)) == "#1f77b4");
+}
+
+TEST_CASE("script-safe JSON has no < > or & and parses back the same") {
+  const nlohmann::json j = {{"label", "imm.p_<!--<script>"}, {"t", "</script><b>&amp;-->"}, {"path", "a\\<b"}};
+  const std::string safe = script_safe_json(j.dump());
+  CHECK(safe.find('<') == std::string::npos);
+  CHECK(safe.find('>') == std::string::npos);
+  CHECK(safe.find('&') == std::string::npos);
+  CHECK(nlohmann::json::parse(safe) == j);
 }

@@ -205,10 +205,10 @@ int cmd_run(int argc, char** argv, bool report_mode = false) {
     if (const host::MpiSession* mpi = mpi_session())
       std::cout << "(runs shared by " << mpi->size() << " MPI processes, " << ro.threads << " thread"
                 << (ro.threads == 1 ? "" : "s") << " each)\n";
-    for (const auto& f : written) std::cout << "wrote " << f << "\n";
+    for (const auto& f : written) std::cout << "wrote " << printable(f) << "\n";
   } else {
     for (const auto& r : results)
-      if (!r.passed) std::cout << "FAIL " << r.text << " (" << r.expect.loc.str() << ")\n";
+      if (!r.passed) std::cout << "FAIL " << printable(r.text) << " (" << printable(r.expect.loc.str()) << ")\n";
   }
   return all_pass ? kOk : kExpectFailed;
 }
@@ -228,7 +228,7 @@ int cmd_validate(int argc, char** argv) {
   if (!parse(argc, argv, o, pos, vm, "Usage: trackflow validate FILE [options]\n\nChecks types, parameters, units, wiring and data files; runs nothing.")) return kOk;
   if (file.empty()) throw po::error("validate needs a pipeline FILE");
   Loaded l = load_pipeline(file, sets, c);
-  std::cout << file << ": ok (" << l.graph.nodes.size() << " nodes, " << l.graph.config.expects.size()
+  std::cout << printable(file) << ": ok (" << l.graph.nodes.size() << " nodes, " << l.graph.config.expects.size()
             << " expect checks)\n";
   return kOk;
 }
@@ -263,11 +263,11 @@ int cmd_plugins(int argc, char** argv) {
       kind_w = std::max(kind_w, std::string(to_string(t.decl.kind)).size());
     }
     for (const auto& p : reg.plugins()) {
-      std::cout << "\n" << p.file << "\n";
+      std::cout << "\n" << printable(p.file) << "\n";
       for (const auto& type : p.types) {
         const auto* t = reg.find(type);
         std::cout << "  " << std::left << std::setw(static_cast<int>(type_w + 2)) << type
-                  << std::setw(static_cast<int>(kind_w + 2)) << to_string(t->decl.kind) << t->decl.summary << "\n";
+                  << std::setw(static_cast<int>(kind_w + 2)) << to_string(t->decl.kind) << printable(t->decl.summary) << "\n";
       }
     }
     for (const auto& p : reg.problems()) std::cout << "\nnot loaded: " << p.str() << "\n";

@@ -121,7 +121,15 @@ int cmd_sweep(int argc, char** argv) {
   const unsigned threads = static_cast<unsigned>(std::max<std::uint64_t>(1, parse_count(threads_text, "--threads", 0, 1024)));
 
   std::vector<host::SweepAxis> axes;
-  for (const auto& p : params) axes.push_back(host::parse_sweep_axis(p));
+  for (const auto& p : params) {
+    axes.push_back(host::parse_sweep_axis(p));
+    // Two axes on one parameter: the later one would win at every point and the rows would be
+    // labelled with the earlier one's values.
+    for (size_t k = 0; k + 1 < axes.size(); ++k)
+      if (axes[k].node == axes.back().node && axes[k].param == axes.back().param)
+        throw po::error("--param " + host::quote_token(axes.back().node + "." + axes.back().param) +
+                        " is given twice; give all its values in one --param");
+  }
   std::vector<host::Override> fixed;
   for (const auto& s : sets) fixed.push_back(host::parse_override(s));
   const auto grid = host::sweep_grid(axes);
@@ -265,10 +273,10 @@ int cmd_sweep(int argc, char** argv) {
     for (const auto& r : rows) width[k] = std::max(width[k], r[k].size());
   }
   std::cout << "sweep " << base.name << ": " << grid.size() << " grid points\n";
-  for (size_t k = 0; k < header.size(); ++k) std::cout << (k ? "  " : "") << std::setw(static_cast<int>(width[k])) << header[k];
+  for (size_t k = 0; k < header.size(); ++k) std::cout << (k ? "  " : "") << std::setw(static_cast<int>(width[k])) << host::printable(header[k]);
   std::cout << "\n";
   for (const auto& r : rows) {
-    for (size_t k = 0; k < r.size(); ++k) std::cout << (k ? "  " : "") << std::setw(static_cast<int>(width[k])) << r[k];
+    for (size_t k = 0; k < r.size(); ++k) std::cout << (k ? "  " : "") << std::setw(static_cast<int>(width[k])) << host::printable(r[k]);
     std::cout << "\n";
   }
   std::vector<report::SweepAxisView> axis_views;

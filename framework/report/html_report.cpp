@@ -4,6 +4,7 @@
 #include "charts.hpp"
 #include "pipeline_layout.hpp"
 #include "report_assets.hpp"
+#include "script_json.hpp"
 
 #include <trackflow/number_text.hpp>
 #include <trackflow/safe_output.hpp>
@@ -149,8 +150,7 @@ class Page {
   std::string finish(const std::string& title) const {
     // Labels come from plugins (metric and series names): invalid UTF-8 becomes U+FFFD, not an exception.
     std::string specs = charts_.dump(-1, ' ', false, json::error_handler_t::replace);
-    // Inside <script>, "</" could end the element; "<\/" is the same JSON string.
-    for (size_t p = specs.find("</"); p != std::string::npos; p = specs.find("</", p + 3)) specs.replace(p, 2, "<\\/");
+    specs = report::script_safe_json(specs);  // a label "<!--<script>" cannot break the page
     std::string out;
     out.reserve(specs.size() + vega_js().size() + vega_lite_js().size() + body_.size() + 4096);
     out += "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n<title>" + esc(title) +

@@ -1,5 +1,6 @@
 // Purpose: YAML loading into a located value tree and parsing of the pipeline's top-level structure.
 #include <trackflow/host/config.hpp>
+#include <trackflow/names.hpp>
 #include <trackflow/host/suggest.hpp>
 
 #include <yaml-cpp/eventhandler.h>
@@ -22,11 +23,32 @@ SourceLoc loc_of(const YAML::Mark& m, const std::string& file) {
   return {file, m.line + 1, m.column + 1};
 }
 
+// Whether the quoted scalar opening at byte `pos` of `text` is closed. yaml-cpp 0.7 takes an
+// unclosed quote as a scalar running to the end of the file (`type: "filter.kalman` became the type
+// "filter.kalman input: cm - id: ...", reported as an unknown type). YAML 1.2 §7.3.1 (a '\\'
+// escape inside "...") and §7.3.2 ('' inside '...').
+bool quote_closed(const std::string& text, std::size_t pos) {
+  const char q = text[pos];
+  for (std::size_t i = pos + 1; i < text.size(); ++i) {
+    if (q == '"' && text[i] == '\\') {
+      ++i;
+    } else if (text[i] == q) {
+      if (q == '\'' && i + 1 < text.size() && text[i + 1] == '\'') {
+        ++i;
+        continue;
+      }
+      return true;
+    }
+  }
+  return false;
+}
+
 // YAML aliases make the node graph a DAG (or, with an alias inside its own anchor, a cycle) that
 // convert() expands into a tree: a budget on the values made and on the depth keeps a small
 // hostile file ("billion laughs", `&a [*a]`) from exhausting memory or the stack.
 struct Expansion {
   const std::string& file;
+  const std::string& text;  // the parsed text, to check quoted scalars against
   std::size_t values = 0;
   std::vector<YAML::Node> path;  // ancestors of the node being converted, to name a recursive alias
 };
@@ -51,10 +73,16 @@ Value convert(const YAML::Node& n, Expansion& x) {
     case YAML::NodeType::Undefined:
       v.kind = Value::Kind::Null;
       break;
-    case YAML::NodeType::Scalar:
+    case YAML::NodeType::Scalar: {
       v.kind = Value::Kind::Scalar;
       v.scalar = n.Scalar();
+      const auto pos = static_cast<std::size_t>(n.Mark().pos);
+      if (n.Mark().pos >= 0 && pos < x.text.size() && (x.text[pos] == '"' || x.text[pos] == '\'') &&
+          !quote_closed(x.text, pos))
+        throw ConfigError(std::string("YAML syntax error: the quote ") + x.text[pos] + " opened here is never closed",
+                          v.loc);
       break;
+    }
     case YAML::NodeType::Sequence:
       v.kind = Value::Kind::List;
       for (const auto& item : n) v.items.push_back(convert(item, x));
@@ -115,7 +143,7 @@ Value parse_text(const std::string& text, const std::string& name) {
   } catch (const YAML::Exception& e) {
     throw ConfigError("YAML syntax error: " + e.msg, loc_of(e.mark, name));
   }
-  Expansion x{name};
+  Expansion x{name, text};
   try {
     return convert(doc, x);
   } catch (const YAML::Exception& e) {
@@ -172,13 +200,10 @@ NodeConfig parse_node(const Value& v) {
   const Value* id = v.find("id");
   if (!id) throw ConfigError("node has no 'id'", v.loc);
   n.id = scalar(*id, "id");
-  // ASCII letters, digits, '_' and '-': ids become file names, JSON keys and CSV columns.
-  const bool plain = !n.id.empty() && n.id.size() <= 100 && std::all_of(n.id.begin(), n.id.end(), [](char c) {
-    return std::isalnum(static_cast<unsigned char>(c)) && static_cast<unsigned char>(c) < 0x80 || c == '_' || c == '-';
-  });
-  if (!plain)
-    throw ConfigError("node id '" + quote_token(n.id) +
-                          "' must be 1 to 100 ASCII letters, digits, '_' or '-' (no '.', '=', space or other characters)",
+  // Ids become file names, JSON keys and CSV columns (names.hpp: the rule shared with other labels).
+  if (!is_plain_name(n.id))
+    throw ConfigError("node id '" + quote_token(n.id) + "' must be " + kPlainNameRule +
+                          " (no '.', '=', space or other characters)",
                       id->loc);
   reject_unknown_keys(v, {"id", "type", "input", "inputs", "attach_to", "params", "doc"}, "node", n.id);
   const Value* type = v.find("type");

@@ -4,6 +4,7 @@
 #include <trackflow/host/guard.hpp>
 #include <trackflow/host/output_names.hpp>
 #include <trackflow/host/suggest.hpp>
+#include <trackflow/names.hpp>
 #include <trackflow/host/validate.hpp>
 #include <trackflow/track_adapters.hpp>
 
@@ -361,6 +362,13 @@ GraphInstance instantiate_checked(const Graph& g, const PluginRegistry& registry
     if (!filter) continue;
     const std::vector<std::string> names = filter->annotation_names();
     if (names.empty()) continue;
+    // Annotation names become CSV columns and chart labels: the node-id rule (names.hpp), for any
+    // plugin (filter.imm checks its mode names at their line already).
+    for (const std::string& a : names)
+      if (!is_plain_name(a))
+        throw ConfigError("filter '" + g.nodes[i].config.id + "' names an annotation '" + quote_token(a) + "'; it must be " +
+                              kPlainNameRule + " (it becomes a CSV column and a chart label)",
+                          g.nodes[i].config.loc, g.nodes[i].config.id);
     if (!FilterControl::reserve_own_annotations(*filter, static_cast<int>(names.size())))
       throw ConfigError("filter '" + g.nodes[i].config.id + "' publishes " + std::to_string(names.size()) +
                             " annotations; at most " + std::to_string(kMaxAnnotations) + " fit on an estimate",

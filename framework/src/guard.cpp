@@ -6,6 +6,7 @@
 #include <signal.h>
 #include <unistd.h>
 
+#include <atomic>
 #include <cstdlib>
 #include <cstring>
 #include <memory>
@@ -52,21 +53,23 @@ void say_number(std::uint64_t v) {
   say(buf + i);
 }
 
-const char* signal_name(int sig) {
-  switch (sig) {
-    case SIGSEGV: return "SIGSEGV, invalid memory access";
-    case SIGBUS: return "SIGBUS, bus error";
-    case SIGFPE: return "SIGFPE, arithmetic fault";
-    case SIGILL: return "SIGILL, illegal instruction";
-    case SIGABRT: return "SIGABRT, abort";
-  }
-  return "fatal signal";
+// Set by the first thread that reports a fatal end (a signal, or exit() inside plugin code).
+// Another thread that crashes at the same moment must neither print a second message nor die by
+// its signal (the process would end by that signal instead of exit 3): it waits for the first
+// one's _exit. Lock-free, so the handler stays async-signal-safe (POSIX.1-2017 XSH 2.4.3).
+std::atomic<bool> g_reporting{false};
+static_assert(std::atomic<bool>::is_always_lock_free);
+
+[[noreturn]] void wait_for_the_first_report() {
+  for (;;) ::pause();
 }
 
-void on_fatal_signal(int sig) {
-  say("\ntrackflow: internal error: crash (");
-  say(signal_name(sig));
-  say(")");
+// "trackflow: internal error: <what> in <node> during run N; a bug in ...", then _exit(3): what
+// a crash and an exit() inside plugin code have in common. write(2) and _exit(2) only.
+[[noreturn]] void report_fatal(const char* what) {
+  if (g_reporting.exchange(true)) wait_for_the_first_report();
+  say("\ntrackflow: internal error: ");
+  say(what);
   const Activity* a = tl_activity;
   const std::string* node = a && a->nodes ? a->nodes->find(detail::executing) : nullptr;
   if (node) {
@@ -88,6 +91,26 @@ void on_fatal_signal(int sig) {
   say(node || (a && a->subject) ? "; a bug in that plugin (or in trackflow)\n"
                                 : "; a bug in trackflow or in a plugin it loaded\n");
   ::_exit(3);
+}
+
+void on_fatal_signal(int sig) {
+  // Without SA_RESETHAND the signal stays blocked while this runs: a fault inside the handler
+  // itself still ends the process by the default action (a blocked synchronous fault is fatal).
+  switch (sig) {
+    case SIGSEGV: report_fatal("crash (SIGSEGV, invalid memory access)");
+    case SIGBUS: report_fatal("crash (SIGBUS, bus error)");
+    case SIGFPE: report_fatal("crash (SIGFPE, arithmetic fault)");
+    case SIGILL: report_fatal("crash (SIGILL, illegal instruction)");
+    case SIGABRT: report_fatal("crash (SIGABRT, abort)");
+  }
+  report_fatal("crash (fatal signal)");
+}
+
+// exit(), std::exit or quick_exit called by plugin code: the engine's own exits happen on
+// threads with no activity (main returns after every scope is gone). A plugin's exit(0) in a run
+// would otherwise end trackflow with status 0, no summary and no outputs.
+void on_exit_inside_plugin_code() {
+  if (tl_activity) report_fatal("exit() called (the process was ended by plugin code)");
 }
 
 }  // namespace
@@ -133,8 +156,10 @@ void rethrow_from_plugin() {
   const std::string* node = a && a->nodes ? a->nodes->find(detail::executing) : nullptr;
   try {
     throw;
-  } catch (const ConfigError&) {
-    throw;
+  } catch (const ConfigError& e) {
+    // Thrown by a plugin during a run: which run, and which node when the error does not say.
+    if (run.empty() && (!node || !e.node().empty())) throw;
+    throw ConfigError(run + (node && e.node().empty() ? *node + ": " : std::string()) + e.what(), e.where(), e.node());
   } catch (const DataError& e) {
     // Bad input data: exit 2, with the run and the node that found it.
     throw DataError(run + (node ? *node + ": " : std::string()) + e.what());
@@ -157,10 +182,13 @@ void install_crash_handler() {
   std::memset(&sa, 0, sizeof sa);
   sa.sa_handler = on_fatal_signal;
   sigemptyset(&sa.sa_mask);
-  // On the alternate stack (a stack overflow leaves no room on the normal one); a fault inside
-  // the handler itself falls back to the default action.
-  sa.sa_flags = SA_ONSTACK | SA_RESETHAND;
+  // On the alternate stack (a stack overflow leaves no room on the normal one). No SA_RESETHAND:
+  // it resets the action for the whole process, so a second thread crashing at the same moment
+  // died by its signal (14 of 30 runs with --threads 2, issue 27); report_fatal holds it instead.
+  sa.sa_flags = SA_ONSTACK;
   for (int sig : {SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT}) ::sigaction(sig, &sa, nullptr);
+  std::atexit(on_exit_inside_plugin_code);
+  std::at_quick_exit(on_exit_inside_plugin_code);
 }
 
 void prepare_thread_for_crash_reports() {

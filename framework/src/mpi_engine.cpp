@@ -1,5 +1,8 @@
 // Purpose: the Monte Carlo ensemble across the processes of an MPI job (Open MPI through Boost.MPI): the MPI-ranks transport of the run dispatcher — rank 0 hands out runs, every process runs them on its threads, results come back as bytes.
+#include <trackflow/data_files.hpp>
 #include <trackflow/host/guard.hpp>
+#include <trackflow/host/suggest.hpp>
+#include <trackflow/number_text.hpp>
 #include <trackflow/host/mpi.hpp>
 #include <trackflow/rng.hpp>
 #include <trackflow/run_result_codec.hpp>
@@ -17,7 +20,9 @@
 #include <chrono>
 #include <condition_variable>
 #include <cstdio>
+#include <cerrno>
 #include <cstdlib>
+#include <cstring>
 #include <deque>
 #include <mutex>
 #include <new>
@@ -32,7 +37,7 @@ namespace mpi = boost::mpi;
 // runs they can take) and get kAssign (run indices; none: stop); they send each run's kResult
 // (the index, then the record's bytes) or kError (the index, then the failure), then kDone; rank 0 ends with kFinal (0 ok,
 // 1 failed) to each once all are done, so every process leaves at the same point.
-enum Tag : int { kRequest = 101, kAssign, kResult, kError, kDone, kFinal, kPayload };
+enum Tag : int { kRequest = 101, kAssign, kResult, kError, kDone, kFinal, kPayload, kIdentity };
 
 // Raw MPI for the point-to-point messages (one MPI message per value, whatever Boost.MPI's
 // version would make of strings and vectors). A byte string goes as its length (kResult or
@@ -141,20 +146,188 @@ RunRecord load_record(ByteReader& in, const GraphInstance& aggregate) {
   return rec;
 }
 
-// What the processes of one job must share for their runs to be interchangeable.
-long long fingerprint(const Graph& g, const RunOptions& opt) {
+// What the processes of one job must share for their runs to be interchangeable, item by item:
+// the build, --seed, --runs, every node's type and every validated parameter value (after --set,
+// defaults included, in SI: "0.5 km" and "500 m" agree), and each data file a component named
+// (data_files.hpp) by its size and content. `shown` is what the refusal quotes (the value as
+// written where there is one).
+struct Identity {
+  std::vector<std::string> names, texts, shown;
+  void add(std::string name, std::string text, std::string as_shown = {}) {
+    names.push_back(std::move(name));
+    shown.push_back(as_shown.empty() ? text : std::move(as_shown));
+    texts.push_back(std::move(text));
+  }
+};
+
+// FNV-1a, 64 bit (Fowler, Noll, Vo; IETF draft-eastlake-fnv): a checksum, not a defence against
+// a chosen collision (the ranks are one analyst's own processes).
+struct Fnv {
   std::uint64_t h = 1469598103934665603ull;
-  auto mix = [&h](std::uint64_t v) { h = (h ^ v) * 1099511628211ull; };
-  mix(static_cast<std::uint64_t>(kAbiVersion));
-  mix(sizeof(Estimate));
-  mix(sizeof(Measurement));
+  void mix(const void* data, std::size_t n) {
+    const auto* p = static_cast<const unsigned char*>(data);
+    for (std::size_t i = 0; i < n; ++i) h = (h ^ p[i]) * 1099511628211ull;
+  }
+  void mix(const std::string& s) { mix(s.data(), s.size() + 1); }  // with its '\0': "ab"+"c" != "a"+"bc"
+};
+
+std::string canonical(const Params& p);
+std::string canonical(const ParamValue& v) {
+  std::string s;
+  switch (v.type) {
+    case ParamType::Real: number_text::append_shortest(s, v.real); break;
+    case ParamType::Integer: s = std::to_string(v.integer); break;
+    case ParamType::Boolean: s = v.boolean ? "true" : "false"; break;
+    case ParamType::String:
+    case ParamType::Choice: s = v.text; break;
+    case ParamType::RealList:
+      s = "[";
+      for (size_t i = 0; i < v.reals.size(); ++i) {
+        if (i) s += ", ";
+        number_text::append_shortest(s, v.reals[i]);
+      }
+      s += "]";
+      break;
+    case ParamType::Records:
+    case ParamType::Component:
+    case ParamType::ComponentList:
+      s = "[";
+      for (size_t i = 0; i < v.records.size(); ++i) s += (i ? ", " : "") + canonical(v.records[i]);
+      for (size_t i = 0; i < v.components.size(); ++i)
+        s += (i || !v.records.empty() ? ", {type: " : "{type: ") + v.components[i].type +
+             (v.components[i].params.values().empty() ? "}" : ", " + canonical(v.components[i].params).substr(1));
+      s += "]";
+      break;
+  }
+  return s;
+}
+std::string canonical(const Params& p) {
+  std::string s = "{";
+  for (size_t i = 0; i < p.values().size(); ++i)
+    s += (i ? ", " : "") + p.values()[i].first + ": " + canonical(p.values()[i].second);
+  return s + "}";
+}
+
+// "12345 bytes, FNV-1a 0123456789abcdef", or why it could not be read (never throws: every rank
+// must reach the comparison, or the others would wait for it forever).
+std::string file_identity(const std::string& path) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return std::string("cannot be read: ") + std::strerror(errno);
+  Fnv h;
+  std::uint64_t size = 0;
+  std::vector<char> buf(1 << 20);
+  for (std::size_t n; (n = std::fread(buf.data(), 1, buf.size(), f)) > 0;) {
+    h.mix(buf.data(), n);
+    size += n;
+  }
+  const bool failed = std::ferror(f) != 0;
+  std::fclose(f);
+  if (failed) return "cannot be read to its end";
+  char hex[17];
+  std::snprintf(hex, sizeof hex, "%016llx", static_cast<unsigned long long>(h.h));
+  return std::to_string(size) + " bytes, FNV-1a " + hex;
+}
+
+Identity identity_of(const Graph& g, const RunOptions& opt) {
+  Identity id;
   const std::uint16_t one = 1;
-  mix(*reinterpret_cast<const std::uint8_t*>(&one));  // byte order: results travel as raw bytes
-  mix(opt.seed);
-  mix(opt.runs);
-  for (const auto& n : g.nodes)
-    for (char c : n.config.id + "/" + n.config.type) mix(static_cast<unsigned char>(c));
-  return static_cast<long long>(h >> 1);
+  id.add("trackflow build", "ABI " + std::to_string(kAbiVersion) + ", SDK " + kSdkVersion + ", Estimate " +
+                                std::to_string(sizeof(Estimate)) + " bytes, Measurement " +
+                                std::to_string(sizeof(Measurement)) + " bytes, " +
+                                (*reinterpret_cast<const std::uint8_t*>(&one) ? "little" : "big") +
+                                " endian");  // results travel as raw bytes
+  id.add("--seed", std::to_string(opt.seed));
+  id.add("--runs", std::to_string(opt.runs));
+  id.add("the number of nodes", std::to_string(g.nodes.size()));
+  for (const auto& n : g.nodes) {
+    id.add("node " + n.config.id, n.config.type);
+    for (const auto& [name, value] : n.params.values()) {
+      const Value* written = n.config.params.find(name);
+      id.add(n.config.id + "." + name, canonical(value),
+             written && written->is_scalar() ? written->scalar : value.from_default ? canonical(value) + " (its default)" : "");
+    }
+  }
+  for (const std::string& path : trackflow::detail::noted_data_files()) id.add("data file '" + path + "'", file_identity(path));
+  return id;
+}
+
+std::vector<std::uint64_t> item_hashes(const Identity& id) {
+  std::vector<std::uint64_t> h(id.names.size());
+  for (size_t i = 0; i < h.size(); ++i) {
+    Fnv f;
+    f.mix(id.names[i]);
+    f.mix(id.texts[i]);
+    h[i] = f.h;
+  }
+  return h;
+}
+
+// The ranks compare one hash of everything; when they differ, rank 0 collects each rank's item
+// hashes, finds the first rank and item that differ from its own, and that rank sends the item's
+// name and value for the message (a few bytes, not every parameter of every rank). Collective:
+// every rank calls it; rank 0 throws the refusal, the others ReportedElsewhere.
+void agree_on_identity(const Graph& g, const RunOptions& opt, mpi::communicator& world) {
+  const Identity id = identity_of(g, opt);
+  const std::vector<std::uint64_t> items = item_hashes(id);
+  Fnv all;
+  all.mix(items.data(), items.size() * sizeof items[0]);
+  const long long mine = static_cast<long long>(all.h >> 1);
+  const long long lo = mpi::all_reduce(world, mine, mpi::minimum<long long>());
+  const long long hi = mpi::all_reduce(world, mine, mpi::maximum<long long>());
+  if (lo == hi) return;
+  const MPI_Comm comm = world;
+  auto pack = [](const std::vector<std::uint64_t>& v) {
+    return std::string(reinterpret_cast<const char*>(v.data()), v.size() * sizeof v[0]);
+  };
+  std::uint64_t where[2] = {0, 0};  // rank, item
+  if (world.rank() == 0) {
+    for (int r = 1; r < world.size(); ++r) {
+      const std::string theirs = recv_bytes(comm, r, kIdentity);
+      if (where[0] != 0) continue;
+      std::vector<std::uint64_t> other(theirs.size() / sizeof(std::uint64_t));
+      std::memcpy(other.data(), theirs.data(), other.size() * sizeof other[0]);
+      if (other == items) continue;
+      std::size_t i = 0;
+      while (i < other.size() && i < items.size() && other[i] == items[i]) ++i;
+      where[0] = static_cast<std::uint64_t>(r);
+      where[1] = i;
+    }
+  } else {
+    send_bytes(comm, 0, kIdentity, pack(items));
+  }
+  MPI_Bcast(where, 2, MPI_UINT64_T, 0, comm);
+  if (where[0] == 0) {  // every rank's item hashes equal rank 0's, yet the totals differed: cannot be
+    if (world.rank() != 0) throw ReportedElsewhere();
+    throw ConfigError("the processes of this MPI job do not run the same pipeline");
+  }
+  const int r = static_cast<int>(where[0]);
+  const std::size_t i = where[1];
+  auto item_text = [&](std::size_t k) {
+    return k < id.names.size() ? id.names[k] + std::string(1, '\0') + id.shown[k] : std::string();
+  };
+  if (world.rank() == r) send_bytes(comm, 0, kIdentity, item_text(i));
+  if (world.rank() != 0) throw ReportedElsewhere();
+  const std::string theirs = recv_bytes(comm, r, kIdentity);
+  const std::size_t cut = theirs.find('\0');
+  const std::string their_name = cut == std::string::npos ? std::string() : theirs.substr(0, cut);
+  const std::string their_value = cut == std::string::npos ? std::string() : theirs.substr(cut + 1);
+  const std::string rank = "rank " + std::to_string(r);
+  std::string what;
+  if (i < id.names.size() && their_name == id.names[i])
+    what = rank + " differs from rank 0 in " + quote_token(id.names[i], 200) + ": '" + quote_token(their_value, 200) +
+           "' vs '" + quote_token(id.shown[i], 200) + "'";
+  else if (i >= id.names.size())
+    what = rank + " has " + quote_token(their_name, 200) + " ('" + quote_token(their_value, 200) +
+           "'), which rank 0 has not";
+  else if (their_name.empty())
+    what = "rank 0 has " + quote_token(id.names[i], 200) + " ('" + quote_token(id.shown[i], 200) + "'), which " + rank +
+           " has not";
+  else
+    what = rank + " has " + quote_token(their_name, 200) + " ('" + quote_token(their_value, 200) + "') where rank 0 has " +
+           quote_token(id.names[i], 200) + " ('" + quote_token(id.shown[i], 200) + "')";
+  throw ConfigError("the processes of this MPI job do not run the same pipeline: " + what +
+                    " (every process must run the same pipeline, --set, data files, --runs, --seed, plugins and "
+                    "trackflow build)");
 }
 
 // How many runs rank 0 hands out ahead of the oldest one not merged: four per thread of the job
@@ -526,14 +699,7 @@ Outcome run_graph_distributed(const Graph& g, const PluginRegistry& registry, co
   RunOptions o = opt;
   o.runs = std::max<std::uint64_t>(1, opt.runs);
   const unsigned threads = std::max(1u, opt.threads);
-  const long long mine = fingerprint(g, o);
-  const long long lo = mpi::all_reduce(world, mine, mpi::minimum<long long>());
-  const long long hi = mpi::all_reduce(world, mine, mpi::maximum<long long>());
-  if (lo != hi) {
-    if (world.rank() != 0) throw ReportedElsewhere();
-    throw ConfigError("the processes of this MPI job do not run the same pipeline (pipeline, --runs, --seed, plugins "
-                      "or trackflow build differ between them)");
-  }
+  agree_on_identity(g, o, world);
   if (world.rank() == 0) return root_rank(g, registry, o, world, threads);
   return worker_rank(g, registry, o, world, threads);
 }

@@ -1,6 +1,8 @@
 // Purpose: plugin discovery and loading with Boost.DLL, with a staged, file-naming error for each failure.
 #include <trackflow/host/guard.hpp>
 #include <trackflow/host/plugins.hpp>
+#include <trackflow/host/suggest.hpp>
+#include <trackflow/names.hpp>
 #include <trackflow/plugin.hpp>
 
 #include <boost/dll/shared_library.hpp>
@@ -132,6 +134,13 @@ void PluginRegistry::load_file(const std::string& path, bool builtin) {
   }
   LoadedPlugin loaded{path, info->plugin_name ? info->plugin_name : "", {}};
   for (auto& d : reg.decls) {
+    // A type name is written in pipelines, listed and printed: "" or one with a space, a line
+    // break or a control character could not be named in a pipeline and would forge output.
+    if (!is_type_name(d.type)) {
+      problems_.push_back({path, "register", "type name '" + quote_token(d.type) + "' refused: a type name is " +
+                                                 kTypeNameRule + " (e.g. filter.kalman)"});
+      continue;
+    }
     const bool part = d.kind == ComponentKind::Associator || d.kind == ComponentKind::Initiator ||
                       d.kind == ComponentKind::Deleter;
     if (part ? !d.create_part : !d.create) {

@@ -128,8 +128,10 @@ std::vector<ExpectResult> check_expects(const Graph& g, const Outcome& out) {
 void print_summary(std::ostream& os, const Graph& g, const Outcome& out, unsigned threads,
                    const std::vector<ExpectResult>& expects) {
   const auto& c = g.config;
-  os << "pipeline " << c.name;
-  if (!c.description.empty()) os << ": " << c.description;
+  // Every text below comes from the pipeline file or a plugin: printed through printable(), so a
+  // description or a sink path cannot send terminal escapes or forge a line with a '\n'.
+  os << "pipeline " << printable(c.name);
+  if (!c.description.empty()) os << ": " << printable(c.description);
   os << "\n  " << out.runs << (out.runs == 1 ? " run" : " runs") << ", " << threads
      << (threads == 1 ? " thread" : " threads") << ", seed " << c.seed << "; " << fmt(out.seconds) << " s\n";
   if (out.filters > 0) {
@@ -144,11 +146,11 @@ void print_summary(std::ostream& os, const Graph& g, const Outcome& out, unsigne
   for (const auto& n : out.nodes) {
     const bool has_any = !n.summary.metrics.empty() || !n.summary.notes.empty() || n.skips > 0 || !n.summary.files.empty();
     if (!has_any) continue;
-    os << "\n" << n.id << " (" << n.type << ")\n";
+    os << "\n" << printable(n.id) << " (" << printable(n.type) << ")\n";
     size_t w = 6;
     for (const auto& m : n.summary.metrics) w = std::max(w, m.name.size() + (m.unit.empty() ? 0 : m.unit.size() + 3));
     for (const auto& m : n.summary.metrics) {
-      std::string label = m.name + (m.unit.empty() ? "" : " [" + m.unit + "]");
+      std::string label = printable(m.name + (m.unit.empty() ? "" : " [" + m.unit + "]"));
       os << "  " << std::left << std::setw(static_cast<int>(w) + 2) << label << std::right << std::setw(12) << fmt(m.value);
       if (m.has_band) {
         const bool in = m.value >= m.band_lo && m.value <= m.band_hi;
@@ -159,18 +161,19 @@ void print_summary(std::ostream& os, const Graph& g, const Outcome& out, unsigne
     }
     if (n.skips > 0) {
       os << "  skipped: " << n.skips << "\n";
-      for (const auto& s : n.skip_examples) os << "    " << s << "\n";
+      for (const auto& s : n.skip_examples) os << "    " << printable(s) << "\n";
       if (n.skips > n.skip_examples.size()) os << "    ...\n";
     }
-    for (const auto& s : n.summary.notes) os << "  " << s << "\n";
-    for (const auto& f : n.summary.files) os << "  wrote " << f << "\n";
+    for (const auto& s : n.summary.notes) os << "  " << printable(s) << "\n";
+    for (const auto& f : n.summary.files) os << "  wrote " << printable(f) << "\n";
   }
-  for (const auto& w : out.warnings) os << "warning: " << w << "\n";
+  for (const auto& w : out.warnings) os << "warning: " << printable(w) << "\n";
   if (!expects.empty()) {
     size_t failed = 0;
     os << "\nexpect\n";
     for (const auto& r : expects) {
-      os << "  " << (r.passed ? "pass  " : "FAIL  ") << r.text << "   (" << r.expect.loc.str() << ")\n";
+      os << "  " << (r.passed ? "pass  " : "FAIL  ") << printable(r.text) << "   (" << printable(r.expect.loc.str())
+         << ")\n";
       failed += r.passed ? 0 : 1;
     }
     os << "  " << expects.size() - failed << " passed, " << failed << " failed\n";

@@ -54,30 +54,38 @@ std::string join_some(const std::vector<std::string>& words, std::size_t max) {
   return join(head) + ", ... (" + std::to_string(words.size() - max) + " more)";
 }
 
-std::string quote_token(std::string_view word, std::size_t max) {
+std::string printable(std::string_view text) {
   std::string s;
-  const std::size_t n = std::min(word.size(), max);
-  s.reserve(n + 3);
+  const std::size_t n = text.size();
+  s.reserve(n);
   for (std::size_t i = 0; i < n;) {
-    const unsigned char c = static_cast<unsigned char>(word[i]);
+    const unsigned char c = static_cast<unsigned char>(text[i]);
     if (c < 0x80) {
       s += c < 0x20 || c == 0x7f ? '?' : static_cast<char>(c);
       ++i;
       continue;
     }
     // A whole, valid UTF-8 sequence is kept; any other byte becomes '?' (the message stays
-    // valid UTF-8 for terminals and JSON).
+    // valid UTF-8 for terminals and JSON). C1 controls (U+0080..U+009F, 0xC2 0x80..0x9F) are
+    // escapes to some terminals too (CSI is U+009B): '?' as well.
     const std::size_t len = c >= 0xF0 && c <= 0xF4 ? 4 : c >= 0xE0 ? 3 : c >= 0xC2 && c <= 0xDF ? 2 : 0;
     bool ok = len > 0 && len <= 4 && i + len <= n;
-    for (std::size_t k = 1; ok && k < len; ++k) ok = (static_cast<unsigned char>(word[i + k]) & 0xC0) == 0x80;
+    for (std::size_t k = 1; ok && k < len; ++k) ok = (static_cast<unsigned char>(text[i + k]) & 0xC0) == 0x80;
+    if (ok && c == 0xC2 && static_cast<unsigned char>(text[i + 1]) < 0xA0) ok = false;
     if (ok) {
-      s.append(word.substr(i, len));
+      s.append(text.substr(i, len));
       i += len;
     } else {
       s += '?';
       ++i;
     }
   }
+  return s;
+}
+
+std::string quote_token(std::string_view word, std::size_t max) {
+  // A sequence cut at `max` is incomplete, so it becomes '?' like any other broken one.
+  std::string s = printable(word.substr(0, std::min(word.size(), max)));
   if (word.size() > max) s += "...";
   return s;
 }

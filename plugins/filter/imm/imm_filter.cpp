@@ -6,6 +6,7 @@
 #include "memory/grow.hpp"
 
 #include <trackflow/common_params.hpp>
+#include <trackflow/names.hpp>
 #include <trackflow/single_track_filter.hpp>
 #include <trackflow/plugin.hpp>
 
@@ -929,6 +930,10 @@ ImmEstimator make_estimator(const Params& p) {
     s.sa0 = r.real_or("initial_sigma_acceleration", s.motion == Settings::Motion::Singer ? s.intensity : 50.0);
     Mode m;
     m.name = r.has("name") ? r.text("name") : default_name(s.motion);
+    // The name becomes a CSV column (p_<name>) and a chart label: the node-id rule (names.hpp).
+    if (!is_plain_name(m.name))
+      throw r.error("name", std::string("a mode name must be ") + kPlainNameRule +
+                                " (it names the annotation p_<name>, a CSV column and a chart label)");
     for (const Mode& other : c.modes)
       if (other.name == m.name)
         throw r.error(r.has("name") ? "name" : "motion",

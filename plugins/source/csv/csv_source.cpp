@@ -5,6 +5,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <trackflow/data_files.hpp>
 #include <trackflow/number_text.hpp>
 #include <trackflow/geometry.hpp>
 #include <trackflow/common_params.hpp>
@@ -213,6 +214,7 @@ class CsvSource final : public Generator {
     current_ = prototype_;  // checking parses into it
     const fs::path path = resolve_path(p);
     file_ = path.string();
+    note_data_file(file_);  // the ranks of an MPI job compare its size and content hash
     const std::string key = cache_key(p, path);
     LogCache& cache = log_cache();
     // Held while checking: instances built at the same time wait for the one check and share it.

@@ -1,18 +1,21 @@
-// Purpose: test-only plugins that misbehave the way a buggy plugin can (test.misbehave: throws, crashes, aborts at a chosen item; test.nan_estimates: publishes NaN; test.nan_filter: a single-track filter whose estimator's state turns NaN), for tests/hostile.
+// Purpose: test-only plugins that misbehave the way a buggy plugin can (test.misbehave: throws, crashes, aborts, exits at a chosen item, alone or on several threads at once; test.nan_estimates: publishes NaN; test.nan_filter: a single-track filter whose estimator's state turns NaN), for tests/hostile.
 #include <trackflow/single_track_filter.hpp>
 #include <trackflow/plugin.hpp>
 
+#include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
 #include <limits>
 #include <stdexcept>
+#include <thread>
 
 namespace {
 
 using namespace trackflow;
 
-enum class What { None, ThrowStd, ThrowInt, ThrowData, Segfault, StackOverflow, Abort };
+enum class What { None, ThrowStd, ThrowInt, ThrowData, ThrowConfig, Segfault, StackOverflow, Abort, Exit0, QuickExit0 };
 
 // Deep recursion that no compiler can turn into a loop: every frame is used after the call.
 int recurse(int n) {
@@ -21,11 +24,24 @@ int recurse(int n) {
   return recurse(n + 1) + frame[0];
 }
 
+// Holds each caller until `n` callers arrived (or 5 s passed): runs on different threads then
+// misbehave at the same moment (two crashes at once, for the crash handler).
+void meet(long long n) {
+  static std::atomic<long long> arrived{0};
+  const long long mine = ++arrived;
+  const auto until = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+  while (arrived.load() < n && mine <= n && std::chrono::steady_clock::now() < until) std::this_thread::yield();
+}
+
 // Passes measurements on; at measurement `at` of run `run` it does `what`.
 class Misbehave final : public Component {
  public:
   explicit Misbehave(const Params& p)
-      : what_(p.choice<What>("what")), at_(p.integer("at")), run_wanted_(static_cast<std::uint64_t>(p.integer("run"))) {}
+      : what_(p.choice<What>("what")),
+        at_(p.integer("at")),
+        every_run_(p.integer("run") < 0),
+        run_wanted_(static_cast<std::uint64_t>(p.integer("run"))),
+        together_(p.integer("together")) {}
 
   void start_run(const RunContext& ctx) override {
     run_ = ctx.run;
@@ -33,7 +49,10 @@ class Misbehave final : public Component {
   }
 
   void on_measurement(const Measurement& m, int) override {
-    if (run_ == run_wanted_ && count_++ == at_) misbehave();
+    if ((every_run_ || run_ == run_wanted_) && count_++ == at_) {
+      if (together_ > 1) meet(together_);
+      misbehave();
+    }
     out.emit(m);
   }
 
@@ -44,6 +63,7 @@ class Misbehave final : public Component {
       case What::ThrowStd: throw std::out_of_range("index 7 out of range (deliberate)");
       case What::ThrowInt: throw 42;
       case What::ThrowData: throw DataError("a deliberate data error");
+      case What::ThrowConfig: throw ConfigError("a deliberate configuration error");
       case What::Segfault: {
         // Not null: a null store is caught by UBSan before it faults; page 0 faults in any build.
         static volatile std::uintptr_t address = 16;
@@ -52,12 +72,16 @@ class Misbehave final : public Component {
       }
       case What::StackOverflow: (void)recurse(0); return;
       case What::Abort: std::abort();
+      case What::Exit0: std::exit(0);
+      case What::QuickExit0: std::quick_exit(0);
     }
   }
 
   const What what_;
   const long long at_;
+  const bool every_run_;
   const std::uint64_t run_wanted_;
+  const long long together_;
   std::uint64_t run_ = 0;
   long long count_ = 0;
 };
@@ -139,13 +163,17 @@ void register_components(Registrar& r) {
                                {What::ThrowStd, "throw_std"},
                                {What::ThrowInt, "throw_int"},
                                {What::ThrowData, "throw_data"},
+                               {What::ThrowConfig, "throw_config"},
                                {What::Segfault, "segfault"},
                                {What::StackOverflow, "stack_overflow"},
-                               {What::Abort, "abort"}},
+                               {What::Abort, "abort"},
+                               {What::Exit0, "exit0"},
+                               {What::QuickExit0, "quick_exit0"}},
                               "what to do")
           .def("none"),
       ParamSpec::integer("at", "0-based index of the measurement of the run at which to misbehave").def("3"),
-      ParamSpec::integer("run", "the run in which to misbehave").def("0"),
+      ParamSpec::integer("run", "the run in which to misbehave (-1: every run)").def("0"),
+      ParamSpec::integer("together", "when above 1: wait until this many runs reached `at` (on other threads), then all misbehave at once").def("0"),
   };
   d.accepts = mask(ItemKind::Measurement);
   d.produces = mask(ItemKind::Measurement);

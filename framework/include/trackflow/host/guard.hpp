@@ -70,7 +70,10 @@ std::string describe_activity();
 [[noreturn]] void rethrow_from_plugin();
 
 // Fatal signals (SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGABRT) print what was running -- the node,
-// its plugin file and the run -- and exit 3 instead of dying by the signal. Installed by the CLI.
+// its plugin file and the run -- and exit 3 instead of dying by the signal; the first thread to
+// crash reports, any other one crashing at the same time waits for its exit. exit(), std::exit
+// and quick_exit called by plugin code (on a thread with an activity) are reported the same way.
+// Installed by the CLI.
 void install_crash_handler();
 // An alternate signal stack for the calling thread, so that a stack overflow in a plugin is
 // reported too. The engine calls it in each worker thread.

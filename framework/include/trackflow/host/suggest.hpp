@@ -17,5 +17,9 @@ std::string join_some(const std::vector<std::string>& words, std::size_t max = 2
 // bytes (then "..."), control characters as '?', so a message never carries more of a file
 // than the offending token, nor terminal escapes.
 std::string quote_token(std::string_view word, std::size_t max = 60);
+// Text from a file (a pipeline's description, a sink's path, a label) as it may be printed to a
+// terminal whole: control characters (C0, DEL, C1) and broken UTF-8 as '?', the rest unchanged,
+// so it can neither send terminal escapes nor forge a line of the summary with a '\n'.
+std::string printable(std::string_view text);
 
 }  // namespace trackflow::host
