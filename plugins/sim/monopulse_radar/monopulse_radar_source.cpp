@@ -211,6 +211,7 @@ class MonopulseRadar final : public Component, public FieldListCodec<MonopulseRu
       const double g = glint_.linear();
       ++run_.glint_n;
       run_.g2 += g * g;
+      run_.g4 += g * g * g * g;
       run_.renewals += renewed;
       run_.laplacian_renewals += renewed && glint_.laplacian();
       if (started_) {
@@ -247,6 +248,7 @@ class MonopulseRadar final : public Component, public FieldListCodec<MonopulseRu
     // Published whether or not the effect is on (NaN when there is nothing to estimate), so a check on
     // them fails rather than naming a metric that does not exist.
     s.metric("glint_variance", t.glint_variance(), "m2");
+    s.metric("glint_kurtosis", t.glint_kurtosis());
     s.metric("glint_lag1_correlation", t.glint_lag1());
     s.metric("glint_correlation_time", sim::ProcessStatistics::correlation_time(t.glint_lag1(), t.mean_step()), "s");
     s.metric("glint_laplacian_fraction", t.renewals ? static_cast<double>(t.laplacian_renewals) / static_cast<double>(t.renewals)
@@ -257,7 +259,8 @@ class MonopulseRadar final : public Component, public FieldListCodec<MonopulseRu
     s.metric("reported_sigma_azimuth", std::sqrt(m_.covariance(1, 1)), "rad");
     s.metric("reported_sigma_elevation", std::sqrt(m_.covariance(2, 2)), "rad");
     s.notes.push_back("pooled over all looks of all runs: glint_variance = mean g^2 of the linear glint (closed form: "
-                      "(glint_factor L)^2), glint_lag1_correlation = sum g_k g_k-1 / sum g_k-1^2 (exp(-2 pi B dt)), "
+                      "(glint_factor L)^2), glint_kurtosis = mean g^4 / (mean g^2)^2 (3 for a Gaussian; the mixture's tails raise "
+                      "it), glint_lag1_correlation = sum g_k g_k-1 / sum g_k-1^2 (exp(-2 pi B dt)), "
                       "glint_correlation_time = -dt / ln(lag-1) (1 / (2 pi B)); rcs_factor_* of RCS / mean (Swerling "
                       "I/II: mean 1, variance 1; III/IV: 1, 1/2; lag-1 correlation exp(-4 pi B dt) per look); "
                       "missed_fraction = looks below detection_threshold");

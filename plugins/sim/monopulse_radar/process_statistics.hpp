@@ -15,7 +15,7 @@ struct ProcessStatistics {
   std::uint64_t pairs = 0;
   // Linear glint g (m): zero mean by construction, so moments about zero.
   std::uint64_t glint_n = 0, renewals = 0, laplacian_renewals = 0;
-  double g2 = 0.0, g_lag = 0.0, g_prev2 = 0.0;
+  double g2 = 0.0, g4 = 0.0, g_lag = 0.0, g_prev2 = 0.0;
   // RCS factor x (mean 1).
   double x = 0.0, x2 = 0.0, x_lag = 0.0, x_prev = 0.0, x_cur_paired = 0.0;
 
@@ -28,6 +28,7 @@ struct ProcessStatistics {
     renewals += o.renewals;
     laplacian_renewals += o.laplacian_renewals;
     g2 += o.g2;
+    g4 += o.g4;
     g_lag += o.g_lag;
     g_prev2 += o.g_prev2;
     x += o.x;
@@ -40,6 +41,9 @@ struct ProcessStatistics {
   static double nan() { return std::numeric_limits<double>::quiet_NaN(); }
   double mean_step() const { return pairs ? time_steps / static_cast<double>(pairs) : nan(); }
   double glint_variance() const { return glint_n ? g2 / static_cast<double>(glint_n) : nan(); }
+  // E[g^4] / E[g^2]^2 of the zero-mean glint: 3 for a Gaussian, 6 for a Laplacian; the glint
+  // mixture's heavy tails (paper 003 eq 3-13) make it large, which is what the AEKF is about.
+  double glint_kurtosis() const { return glint_n && g2 > 0.0 ? g4 * static_cast<double>(glint_n) / (g2 * g2) : nan(); }
   // sum g_k g_{k-1} / sum g_{k-1}^2: the lag-1 autocorrelation of a zero-mean process.
   double glint_lag1() const { return g_prev2 > 0.0 ? g_lag / g_prev2 : nan(); }
   double rcs_mean() const { return looks ? x / static_cast<double>(looks) : nan(); }

@@ -1,5 +1,6 @@
 // Purpose: tests of the glint mixture (eq 3-9..3-11): its variances, marginal, Lorentzian correlation, per-axis split and the RCS coupling.
 #include "glint.hpp"
+#include "process_statistics.hpp"
 #include "test_statistics.hpp"
 
 #include <catch2/catch.hpp>
@@ -87,6 +88,18 @@ TEST_CASE("glint mixture variance is 90.24 m2") {
     for (double g : d.linear) above += std::abs(g) > 8 * sg;
     const double p = 0.5 * std::exp(-std::sqrt(2.0) * 8 * sg / sl);
     CHECK(std::abs(above / n - p) < 5 * std::sqrt(p * (1 - p) / n));
+    // The shape the summary reports (glint_kurtosis, process_statistics.hpp): E g^4 / sigma^4 =
+    // 95 805 / 90.25^2 = 11.76. Its standard error from E g^8 = 0.5 * 105 s_g^8 + 0.5 * 2520 s_l^8
+    // (the Laplacian's eighth moment is 8! b^8 = 2520 var^4): ~0.22 at n = 400 000; bound 5 of them.
+    ProcessStatistics stats;
+    for (double g : d.linear) {
+      ++stats.glint_n;
+      stats.g2 += g * g;
+      stats.g4 += g * g * g * g;
+    }
+    const double eighth = 0.5 * 105 * std::pow(1.787, 4) + 0.5 * 2520 * std::pow(178.7, 4);
+    const double kurtosis_se = std::sqrt((eighth - fourth * fourth) / n) / (90.25 * 90.25);
+    CHECK(std::abs(stats.glint_kurtosis() - fourth / (90.25 * 90.25)) < 5 * kurtosis_se);
   }
 }
 
