@@ -22,13 +22,22 @@ std::size_t edit_distance(const std::string& a, const std::string& b) {
 std::string did_you_mean(const std::string& word, const std::vector<std::string>& candidates) {
   // Edit distance is quadratic in the lengths: a long word is not a typo of a name.
   if (word.size() > 64) return {};
+  // Letter case costs nothing first (filter.UKF is filter.ukf, not filter.ekf: issue 26), the exact
+  // distance breaks ties.
+  auto lower = [](std::string x) {
+    for (char& ch : x)
+      if (ch >= 'A' && ch <= 'Z') ch = static_cast<char>(ch - 'A' + 'a');
+    return x;
+  };
+  const std::string word_lower = lower(word);
   std::string best;
-  std::size_t best_d = std::string::npos;
+  std::size_t best_d = std::string::npos, best_exact = std::string::npos;
   for (const auto& c : candidates) {
     if (c.size() > 64) continue;
-    const std::size_t d = edit_distance(word, c);
-    if (d < best_d) {
+    const std::size_t d = edit_distance(word_lower, lower(c)), exact = edit_distance(word, c);
+    if (d < best_d || (d == best_d && exact < best_exact)) {
       best_d = d;
+      best_exact = exact;
       best = c;
     }
   }

@@ -16,6 +16,9 @@ expect_run "the summary counts measurements processed and their rate" 0 "measure
 base | sed 's/type: filter.kalman/type: filter.kalmn/' > "$TMP/unknown_type.yaml"
 expect_run "unknown type" 2 "unknown_type.yaml:18:11: node 'kf': unknown type 'filter.kalmn' \(did you mean 'filter.kalman'\?\). Available: .*sink.metrics" \
   -- "$TF" validate "$TMP/unknown_type.yaml"
+base | sed 's/type: filter.kalman/type: filter.UKF/' > "$TMP/upper_type.yaml"
+expect_run "a type in the wrong letter case is suggested in the right one" 2 "unknown type 'filter.UKF' \(did you mean 'filter.ukf'\?\)" \
+  -- "$TF" validate "$TMP/upper_type.yaml"
 
 base | sed 's/sigma_range: 10 m/sigma_rnge: 10 m/' > "$TMP/unknown_param.yaml"
 expect_run "unknown parameter, with suggestion" 2 "unknown_param.yaml:13:15: node 'radar': unknown parameter 'sigma_rnge' \(did you mean 'sigma_range'\?\)" \
