@@ -44,8 +44,13 @@ const Metric& find_metric(const Outcome& out, const std::string& node, const std
   if (!m) {
     std::vector<std::string> names;
     for (const auto& x : n->summary.metrics) names.push_back(x.name);
+    // Its notes say why a metric is missing (e.g. sink.metrics without truth: no errors, issue 26).
+    std::string why;
+    for (const auto& note : n->summary.notes)
+      if (note.find("not reported") != std::string::npos || note.rfind("no truth", 0) == 0)
+        why += (why.empty() ? "; its notes say: " : "; ") + note;
     throw ConfigError("expect: node '" + node + "' has no metric '" + metric + "'" + did_you_mean(metric, names) +
-                          "; it reports: " + (names.empty() ? "none" : join(names)),
+                          "; it reports: " + (names.empty() ? "none" : join(names)) + why,
                       loc);
   }
   return *m;

@@ -96,6 +96,9 @@ expect_run "a failed expect exits 1" 1 "FAIL  score.position_rmse" -- "$TF" run 
 { base; printf 'expect:\n  score.position_rmsee: { max: 1 }\n'; } > "$TMP/expect_typo.yaml"
 expect_run "an expect naming a missing metric is a config error" 2 "has no metric 'position_rmsee' \(did you mean 'position_rmse'\?\)" \
   -- "$TF" run "$TMP/expect_typo.yaml" --out "$TMP/out"
+{ base | sed 's/inputs: \[kf, truth\]/inputs: [kf]/'; printf 'expect:\n  score.position_rmse: { max: 1 }\n'; } > "$TMP/expect_no_truth.yaml"
+expect_run "a metric missing for a reason says the reason" 2 "has no metric 'position_rmse'; it reports: .*; its notes say: no truth input" \
+  -- "$TF" run "$TMP/expect_no_truth.yaml" --out "$TMP/out"
 { base; printf 'expect:\n  score.position_rmse: { less_than: score.velocity_rmsee }\n'; } > "$TMP/expect_ref.yaml"
 expect_run "a less_than reference to a missing metric is a config error" 2 "has no metric 'velocity_rmsee' \(did you mean 'velocity_rmse'\?\)" \
   -- "$TF" run "$TMP/expect_ref.yaml" --out "$TMP/out"
