@@ -92,6 +92,7 @@ int cmd_sweep(int argc, char** argv) {
   std::string file, csv_path, report_path;
   std::vector<std::string> params, sets, metric_names;
   std::string runs_text, seed_text, threads_text = "1";
+  bool quiet = false;
   po::options_description o("trackflow sweep options");
   o.add_options()("help,h", "show this help")("file", po::value(&file), "pipeline YAML file")(
       "param,p", po::value(&params)->composing(), "a grid axis: node.param=v1,v2,... (repeatable)")(
@@ -104,7 +105,8 @@ int cmd_sweep(int argc, char** argv) {
       "set", po::value(&sets)->composing(), "fixed override for every point, as for run")(
       "csv", po::value(&csv_path), "also write the table to this CSV file (SI numbers, units in the header)")(
       "report", po::value(&report_path), "also write an HTML report: each metric against the first numeric axis")(
-      "out,o", po::value<std::string>(), "folder for files written by sinks (default: out/<name>/sweep-<i>)");
+      "out,o", po::value<std::string>(), "folder for files written by sinks (default: out/<name>/sweep-<i>)")(
+      "quiet,q", po::bool_switch(&quiet), "print only the table and errors (no progress, header or 'wrote' lines)");
   o.add(common_options(c));
   o.add(trust_options(c));
   po::positional_options_description pos;
@@ -193,7 +195,7 @@ int cmd_sweep(int argc, char** argv) {
         next = grid.size();
       }
       const size_t d = ++done;
-      if (::isatty(STDERR_FILENO)) std::cerr << "\rgrid point " << d << "/" << grid.size() << std::flush;
+      if (!quiet && ::isatty(STDERR_FILENO)) std::cerr << "\rgrid point " << d << "/" << grid.size() << std::flush;
     }
   };
   if (host::MpiSession* mpi = mpi_session()) {
@@ -206,7 +208,7 @@ int cmd_sweep(int argc, char** argv) {
       ro.threads = std::max(1u, threads);
       ro.output_dir = (std::filesystem::path(out_root) / ("sweep-" + std::to_string(i))).string();
       outcomes[i] = run_ensemble(graphs[i], reg, ro);
-      if (is_root() && ::isatty(STDERR_FILENO)) std::cerr << "\rgrid point " << i + 1 << "/" << grid.size() << std::flush;
+      if (!quiet && is_root() && ::isatty(STDERR_FILENO)) std::cerr << "\rgrid point " << i + 1 << "/" << grid.size() << std::flush;
     }
     if (!is_root()) return kOk;
   } else {
@@ -230,7 +232,7 @@ int cmd_sweep(int argc, char** argv) {
       if (pool.empty()) worker();
     }
   }
-  if (::isatty(STDERR_FILENO)) std::cerr << "\n";
+  if (!quiet && ::isatty(STDERR_FILENO)) std::cerr << "\n";
   if (error) std::rethrow_exception(error);
 
   std::vector<MetricRef> metrics;
@@ -272,7 +274,7 @@ int cmd_sweep(int argc, char** argv) {
     width[k] = header[k].size();
     for (const auto& r : rows) width[k] = std::max(width[k], r[k].size());
   }
-  std::cout << "sweep " << base.name << ": " << grid.size() << " grid points\n";
+  if (!quiet) std::cout << "sweep " << base.name << ": " << grid.size() << " grid points\n";
   for (size_t k = 0; k < header.size(); ++k) std::cout << (k ? "  " : "") << std::setw(static_cast<int>(width[k])) << host::printable(header[k]);
   std::cout << "\n";
   for (const auto& r : rows) {
@@ -303,7 +305,7 @@ int cmd_sweep(int argc, char** argv) {
       text += "\n";
     }
     report::write_text_file(csv_path, text);
-    std::cout << "wrote " << csv_path << "\n";
+    if (!quiet) std::cout << "wrote " << csv_path << "\n";
   }
   if (!report_path.empty()) {
     report::SweepReport r;
@@ -314,7 +316,7 @@ int cmd_sweep(int argc, char** argv) {
     r.metrics = metric_views;
     if (!csv_path.empty()) r.files.push_back(csv_path);
     report::write_text_file(report_path, report::render_sweep_report(r));
-    std::cout << "wrote " << report_path << "\n";
+    if (!quiet) std::cout << "wrote " << report_path << "\n";
   }
   return kOk;
 }

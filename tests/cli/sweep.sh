@@ -44,4 +44,9 @@ expect_run "a bad grid value names the grid point" 2 "parameter 'q'.*'fast' is n
   "$TF" sweep "$P" --param kf.q=0,fast --runs 2 --out "$TMP/out"
 expect_run "sweep without --param" 2 "needs at least one --param" -- "$TF" sweep "$P"
 expect_run "sweep --help explains the grid" 0 "Cartesian product" -- "$TF" sweep --help
+"$TF" sweep "$P" -q --param kf.q=0,1 --runs 2 --csv "$TMP/q.csv" --out "$TMP/out" > "$TMP/quiet.txt" 2>&1 || fail "sweep -q failed"
+head -1 "$TMP/quiet.txt" | grep -Eq "^kf.q +score" || fail "sweep -q: the table is not the first line: $(head -2 "$TMP/quiet.txt")"
+[ "$(wc -l < "$TMP/quiet.txt")" -eq 3 ] || fail "sweep -q prints more than the table: $(cat "$TMP/quiet.txt")"
+echo "ok: sweep -q prints only the table (issue 26)"
+checks=$((checks + 1))
 finish
