@@ -28,9 +28,17 @@ std::string kinds(ItemMask m) {
 
 std::string unknown_type_message(const std::string& type, const PluginRegistry& reg) {
   const auto names = reg.type_names();
-  std::string m = "unknown type '" + quote_token(type) + "'" + did_you_mean(type, names) + ". Available: " +
+  const std::string suggestion = did_you_mean(type, names);
+  std::string m = "unknown type '" + quote_token(type) + "'" + suggestion + ". Available: " +
                   (names.empty() ? "none" : join(names)) + ". Searched: " + join(reg.searched());
+  // Not a typo of ours: most likely a third-party plugin whose folder was not given (issue 26).
+  if (suggestion.empty())
+    m += ". A type from another plugin: give its folder with --plugin-path DIR (or TRACKFLOW_PLUGIN_PATH)";
   for (const auto& p : reg.problems()) m += "\n  plugin not loaded: " + p.str();
+  std::vector<std::string> ignored = reg.ignored();
+  std::sort(ignored.begin(), ignored.end());
+  for (const auto& f : ignored)
+    m += "\n  not loaded: '" + quote_token(f) + "' (plugin files are named tfplugin_<name>.so)";
   return m;
 }
 

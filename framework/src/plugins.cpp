@@ -63,7 +63,11 @@ void PluginRegistry::load_directories(const std::vector<std::string>& dirs, bool
     for (fs::directory_iterator it(d, ec), end; !ec && it != end; it.increment(ec)) {
       const fs::path& p = it->path();
       const auto name = p.filename().string();
-      if (name.rfind("tfplugin_", 0) == 0 && p.extension() == ".so") files.push_back(p);
+      if (p.extension() != ".so") continue;
+      if (name.rfind("tfplugin_", 0) == 0)
+        files.push_back(p);
+      else
+        ignored_.push_back(p.string());
     }
     std::sort(files.begin(), files.end());  // directory order is arbitrary; loading order must not be
     for (const auto& f : files) load_file(f.string(), builtin);

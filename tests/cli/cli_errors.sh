@@ -16,6 +16,13 @@ expect_run "the summary counts measurements processed and their rate" 0 "measure
 base | sed 's/type: filter.kalman/type: filter.kalmn/' > "$TMP/unknown_type.yaml"
 expect_run "unknown type" 2 "unknown_type.yaml:18:11: node 'kf': unknown type 'filter.kalmn' \(did you mean 'filter.kalman'\?\). Available: .*sink.metrics" \
   -- "$TF" validate "$TMP/unknown_type.yaml"
+base | sed 's/type: filter.kalman/type: acme.alphabeta_tracker/' > "$TMP/third_party.yaml"
+expect_run "an unknown third-party type suggests --plugin-path" 2 "unknown type 'acme.alphabeta_tracker'\. Available: .*A type from another plugin: give its folder with --plugin-path DIR" \
+  -- "$TF" validate "$TMP/third_party.yaml"
+mkdir -p "$TMP/misnamed"
+cp "$(ls "$(dirname "$TF")"/../lib/trackflow/plugins/tfplugin_*.so | head -1)" "$TMP/misnamed/alphabeta.so"
+expect_run "a misnamed plugin file in a plugin folder is named" 2 "not loaded: '$TMP/misnamed/alphabeta.so' \(plugin files are named tfplugin_<name>.so\)" \
+  -- "$TF" validate "$TMP/third_party.yaml" --plugin-path "$TMP/misnamed"
 base | sed 's/type: filter.kalman/type: filter.UKF/' > "$TMP/upper_type.yaml"
 expect_run "a type in the wrong letter case is suggested in the right one" 2 "unknown type 'filter.UKF' \(did you mean 'filter.ukf'\?\)" \
   -- "$TF" validate "$TMP/upper_type.yaml"

@@ -54,6 +54,9 @@ class PluginRegistry {
   const std::vector<LoadedPlugin>& plugins() const { return plugins_; }
   const std::vector<LoadProblem>& problems() const { return problems_; }
   const std::vector<std::string>& searched() const { return searched_; }
+  // Shared objects in the searched folders not named tfplugin_*.so (not loaded: a plugin's own
+  // libraries may sit beside it, but a misnamed plugin is told when its type is not found).
+  const std::vector<std::string>& ignored() const { return ignored_; }
 
   // The component lives as long as the returned pointer; its deleter keeps the library loaded.
   std::shared_ptr<Component> create(const RegisteredType& t, const Params& p) const;
@@ -66,6 +69,7 @@ class PluginRegistry {
   std::vector<LoadedPlugin> plugins_;
   std::vector<LoadProblem> problems_;
   std::vector<std::string> searched_;
+  std::vector<std::string> ignored_;
   std::vector<std::string> replaceable_;
 };
 
