@@ -38,7 +38,7 @@ TEST_CASE("number_range: refused small numbers are underflows") {
   }
 }
 
-TEST_CASE("number_range: the quantity parser names the end of the range, not 'not a number'") {
+TEST_CASE("number_range: parse_quantity names the end of the range") {
   auto message = [](const char* text) {
     try {
       trackflow::parse_quantity(text);
