@@ -123,6 +123,8 @@ printf 'time,range,azimuth,elevation\n0,10000,30,5\n0.1,10000,1e300,5\n0.2,10000
 log_pipeline "$TMP/spin.csv" > "$TMP/spin.yaml"
 expect_run "a 1e300 deg azimuth in a log is a bad row naming file:line" 2 "spin.csv:3: azimuth beyond \+-360 deg \(column azimuth, value '1e300'\)" \
   -- "$TF" validate "$TMP/spin.yaml"
+sed "s|path: $TMP/spin.csv|path: $TMP/spin.csv, on_bad_row: skip|" "$TMP/spin.yaml" > "$TMP/spin_skip.yaml"
+expect_run "... or, with on_bad_row: skip, left out and counted" 0 "skipped_rows +1" -- "$TF" run "$TMP/spin_skip.yaml" --out "$TMP/o"
 printf 'time,range,azimuth,elevation\n1e-400,10000,30,5\n0.1,10000,30,5\n' > "$TMP/tiny.csv"
 log_pipeline "$TMP/tiny.csv" > "$TMP/tiny.yaml"
 expect_run "a time of 1e-400 is an underflow, not 'NaN or infinite'" 2 \

@@ -436,7 +436,9 @@ void register_components(Registrar& r) {
       // S^2, so at 1e-300 (accepted before, issue 27) every velocity variance underflowed to 0. 1e-12
       // already puts a 1 mm^2 variance at 1e-30 with the whole double range left.
       ParamSpec::real("state_scale", dim::none,
-                      "factor on the nine Cartesian states inside the filter, 1e-12 to 1e6 (paper: 1e-6; 1: off)")
+                      "factor on the nine Cartesian states inside the filter, 1e-12 to 1e6 (paper: 1e-6; 1: off; the "
+                      "covariance scales by its square, so smaller factors only push the scaled variances towards "
+                      "underflow)")
           .def("1e-6")
           .at_least(1e-12)
           .at_most(1e6),
