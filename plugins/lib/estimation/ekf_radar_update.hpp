@@ -194,16 +194,19 @@ inline std::string relinearised_text(int count, int updates) {
          "about the prediction (see q)";
 }
 
+// `iterate`: whether a prior much wider than the measurement may take the iterated update
+// (filter.ekf); filter.imm's modes pass false: their likelihoods and the gate are the single
+// linearisation's, and the IMM's results stay what they were.
 template <int N, int M>
 EkfOutcome ekf_radar_update(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double, N, N>& P, const int idx[6],
                             const Measurement& m, const Eigen::Matrix<double, M, M>& R_measured, bool curvature,
-                            EkfInnovation<M>& out) {
+                            EkfInnovation<M>& out, bool iterate = true) {
   Eigen::Matrix<double, N, M> PHt;
   if (ekf_radar_linearise<N, M>(x, P, idx, m, R_measured, curvature, out, PHt) == EkfOutcome::AtSensor)
     return EkfOutcome::AtSensor;
   // The zenith conditioning acted on a prediction much wider than the measurement: the measurement,
   // not the prior, says where the target is (and whether it is near the zenith).
-  if ((out.azimuth_dropped || out.azimuth_deweighted) && prior_much_wider<N, M>(x, P, idx, m, R_measured))
+  if (iterate && (out.azimuth_dropped || out.azimuth_deweighted) && prior_much_wider<N, M>(x, P, idx, m, R_measured))
     return ekf_radar_iterated_update<N, M>(x, P, idx, m, R_measured, out);
   if (joseph_update_cross<N, M>(x, P, out.nu, PHt, out.S, out.nis, nullptr, &out.det_S)) return EkfOutcome::Used;
   return EkfOutcome::NotPositiveDefinite;
