@@ -60,7 +60,7 @@ TEST_CASE("parameter errors name line/column/node") {
   CHECK(e.message().find("expects 3 values") != std::string::npos);
 
   e = validate_error("rate: -1 Hz\n");
-  CHECK(e.message().find("positive") != std::string::npos);
+  CHECK(e.message().find("must be > 0, got '-1 Hz'") != std::string::npos);
 }
 
 TEST_CASE("pipeline structure errors") {

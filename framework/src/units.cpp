@@ -1,6 +1,8 @@
 // Purpose: parsing of quantities with units into SI values and dimensions.
 #include <trackflow/units.hpp>
 
+#include <trackflow/number_range.hpp>
+
 #include <cctype>
 #include <charconv>
 #include <cmath>
@@ -131,6 +133,9 @@ Quantity parse_quantity(std::string_view text) {
   const char* first = s.data() + (s.size() > 1 && s[0] == '+' && s[1] != '-' && s[1] != '+' ? 1 : 0);
   const char* last = s.data() + s.size();
   auto [ptr, ec] = std::from_chars(first, last, v);
+  if (ec == std::errc::result_out_of_range)  // a number, but beyond a double's range: say which end
+    throw std::invalid_argument("'" + token(s) + "' " +
+                                number_range::describe(number_range::classify(std::string_view(first, ptr - first))));
   if (ec != std::errc()) {
     throw std::invalid_argument("'" + token(s) + "' is not a number");
   }

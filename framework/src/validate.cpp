@@ -1,18 +1,41 @@
 // Purpose: validation of node parameters against their declarations (type, unit dimension, range).
 #include <trackflow/host/suggest.hpp>
 #include <trackflow/host/validate.hpp>
+#include <trackflow/number_text.hpp>
 
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <sstream>
 
 namespace trackflow::host {
 namespace {
 
+// Shortest round-trip digits, but a whole number below 1e15 in full ("100000", not "1e+05").
 std::string fmt_si(double v) {
-  std::ostringstream o;
-  o << v;
-  return o.str();
+  if (v == std::floor(v) && std::fabs(v) < 1e15) return number_text::fixed(v, 0);
+  return number_text::shortest(v);
+}
+
+// A declared range as an analyst reads it: "> 0 and <= 1", ">= -11000 m and <= 100000 m",
+// "> 0 and <= 30 deg" (issue 26: the old "between 4.94066e-324 and 1 1" printed
+// ParamSpec::positive()'s smallest double and the dimension "1" of a plain number). Bounds in the
+// declaration's SI unit with shortest round-trip digits; a plain angle in degrees (6 digits), the
+// unit analysts give angles in (30 deg, not 0.5235987755982988 rad).
+std::string range_text(const ParamSpec& s) {
+  const bool degrees = s.dimension == dim::angle;
+  const std::string unit = degrees ? " deg" : s.dimension.dimensionless() ? "" : " " + s.dimension.str();
+  auto value = [&](double v) {
+    return (degrees ? number_text::general(v * 180.0 / std::numbers::pi, 6) : fmt_si(v)) + unit;
+  };
+  std::string lo, hi;
+  if (s.min > 0 && s.min < 1e-300)
+    lo = "> 0";  // positive(): denorm_min; zero needs no unit
+  else if (std::isfinite(s.min))
+    lo = ">= " + value(s.min);
+  if (std::isfinite(s.max)) hi = "<= " + value(s.max);
+  if (lo.empty()) return hi;
+  return hi.empty() ? lo : lo + " and " + hi;
 }
 
 double parse_real(const ParamSpec& s, const Value& v, const std::string& node) {
@@ -29,18 +52,9 @@ double parse_real(const ParamSpec& s, const Value& v, const std::string& node) {
     throw ConfigError("parameter '" + s.name + "' has unit dimension " + s.dimension.str() + ", but '" + quote_token(v.scalar) +
                           "' is " + q.dimension.str(),
                       v.loc, node);
-  if (q.value < s.min || q.value > s.max) {
-    std::string range;
-    if (std::isfinite(s.min) && std::isfinite(s.max))
-      range = "between " + fmt_si(s.min) + " and " + fmt_si(s.max);
-    else if (std::isfinite(s.min))
-      range = s.min > 0 && s.min < 1e-300 ? std::string("positive") : "at least " + fmt_si(s.min);
-    else
-      range = "at most " + fmt_si(s.max);
-    throw ConfigError("parameter '" + s.name + "' must be " + range + " " + s.dimension.str() + ", got '" + quote_token(v.scalar) +
-                          "'",
+  if (q.value < s.min || q.value > s.max)
+    throw ConfigError("parameter '" + s.name + "' must be " + range_text(s) + ", got '" + quote_token(v.scalar) + "'",
                       v.loc, node);
-  }
   return q.value;
 }
 

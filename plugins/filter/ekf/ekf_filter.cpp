@@ -52,8 +52,14 @@ class ExtendedKalmanFilter final
  private:
   enum Counter { kAzimuthDropped, kAzimuthDeweighted };
 
-  void on_start_run() { zenith_reported_ = false; }
-  void on_end_run_report() {}
+  void on_start_run() {
+    zenith_reported_ = false;
+    relinearised_ = updates_ = 0;
+  }
+  // Counted per run and reported once at its end rather than at every step.
+  void on_end_run_report() {
+    if (relinearised_ > 0) this->warn(cartesian_filter::relinearised_text(relinearised_, updates_));
+  }
 
   // The update itself is shared with filter.imm's modes (ekf_radar_update.hpp); this is its
   // reporting: counts, and warnings once per run.
@@ -100,6 +106,8 @@ class ExtendedKalmanFilter final
                  " s: no direction to linearise about; measurement not used");
       return false;
     }
+    ++updates_;
+    if (in.relinearised) ++relinearised_;
     if (in.azimuth_dropped) this->count(kAzimuthDropped);
     if (in.azimuth_deweighted) this->count(kAzimuthDeweighted);
     if (!zenith_reported_ && (in.azimuth_dropped || in.azimuth_deweighted)) {
@@ -119,6 +127,7 @@ class ExtendedKalmanFilter final
   }
 
   bool zenith_reported_ = false;
+  int relinearised_ = 0, updates_ = 0;
 };
 
 cartesian_filter::Settings settings(const Params& p) {
@@ -152,7 +161,9 @@ void register_components(Registrar& r) {
       "CA (Wiener-process acceleration, q_jerk, paper 000 eq 3.19), sigma_accel for the discrete white-noise "
       "variants, or Singer (alpha, sigma_m; exact discretisation). Near the zenith the angles' curvature variance is "
       "added to R and the azimuth is dropped while the zenith is within 3 sigma (zenith: curvature; zenith: textbook "
-      "is the plain EKF); dropped and de-weighted azimuths are counted in the summary. Invalid measurements: predict "
+      "is the plain EKF); dropped and de-weighted azimuths are counted in the summary. With zenith: curvature, a "
+      "prediction whose horizontal variance exceeds 100 times the measurement's (a huge q) and on which either rule "
+      "acts is updated by the iterated EKF about the measured position instead (reported at the end of the run). Invalid measurements: predict "
       "only. "
       "R from each measurement in spherical space (adapters may replace it; q per ENU axis). A 2-D surveillance "
       "radar's polar [r, az(, rdot)] measurements: h is the same model's range, azimuth (and range-rate) rows; a "

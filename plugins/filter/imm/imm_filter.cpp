@@ -180,7 +180,8 @@ class ImmEstimator final : public Estimator {
     for (int j = 0; j < count_; ++j) {
       cartesian_filter::EkfOutcome outcome{};
       visit(modes_[j], [&](auto& s) {
-        outcome = cartesian_filter::ekf_radar_update<3 * order_of<decltype(s)>, M>(s.x_, s.P_, s.idx_, m, R, uses_curvature(s), innovation<M>(j));
+        outcome = cartesian_filter::ekf_radar_update<3 * order_of<decltype(s)>, M>(
+            s.x_, s.P_, s.idx_, m, R, uses_curvature(s), innovation<M>(j), /*iterate=*/false);
       });
       used[j] = outcome == cartesian_filter::EkfOutcome::Used;
       dropped = dropped || innovation<M>(j).azimuth_dropped;
@@ -233,7 +234,8 @@ class ImmEstimator final : public Estimator {
           constexpr int N = 3 * order_of<decltype(s)>;
           Eigen::Matrix<double, N, 1> x = s.x_;
           Eigen::Matrix<double, N, N> P = s.P_;
-          outcome = cartesian_filter::ekf_radar_update<N, M>(x, P, s.idx_, m, R, uses_curvature(s), innovation<M>(j));
+          outcome = cartesian_filter::ekf_radar_update<N, M>(x, P, s.idx_, m, R, uses_curvature(s), innovation<M>(j),
+                                                             /*iterate=*/false);
           if (outcome == cartesian_filter::EkfOutcome::Used) {
             dx[j].template head<N>() = x - s.x_;
             Pk[j].template topLeftCorner<N, N>() = P;

@@ -432,9 +432,15 @@ void register_components(Registrar& r) {
                                        "paper 004 eq 11 on every update, only when ||K|| > 1, or not at all")
           .def("always"),
       ParamSpec::real("gain_lambda", dim::none, "eq 11's lambda on the radar-state rows (paper: 0.1)").def("0.1").positive().at_most(1e3),
-      ParamSpec::real("state_scale", dim::none, "factor on the nine Cartesian states inside the filter (paper: 1e-6; 1: off)")
+      // Scaling only conditions the arithmetic (paper 004 §2.4: 1e-6); the covariance is scaled by
+      // S^2, so at 1e-300 (accepted before, issue 27) every velocity variance underflowed to 0. 1e-12
+      // already puts a 1 mm^2 variance at 1e-30 with the whole double range left.
+      ParamSpec::real("state_scale", dim::none,
+                      "factor on the nine Cartesian states inside the filter, 1e-12 to 1e6 (paper: 1e-6; 1: off; the "
+                      "covariance scales by its square, so smaller factors only push the scaled variances towards "
+                      "underflow)")
           .def("1e-6")
-          .positive()
+          .at_least(1e-12)
           .at_most(1e6),
       ParamSpec::choice<NoiseSource>("measurement_noise",
                                      {{NoiseSource::Reported, "reported"}, {NoiseSource::LowPass, "low_pass"}},

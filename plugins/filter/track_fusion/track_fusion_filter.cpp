@@ -8,6 +8,7 @@
 #include <trackflow/run_result_codec.hpp>
 #include <trackflow/transition_model.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <string>
@@ -86,7 +87,15 @@ class TrackFusion final : public Component, public FieldListCodec<FusionRunResul
 
   void set_inputs(const std::vector<InputInfo>& inputs) override {
     inputs_.clear();
-    for (const InputInfo& in : inputs) inputs_.push_back(in.node);
+    for (const InputInfo& in : inputs) {
+      // The same track twice is not two sensors: fusing it with itself counts its information
+      // twice (the fused covariance halves with no new data), so it is refused (issue 27).
+      if (std::find(inputs_.begin(), inputs_.end(), in.node) != inputs_.end())
+        throw ConfigError("filter.track_fusion (node '" + s_.node + "'): input '" + in.node +
+                          "' is listed twice; fusing a track with itself counts its information twice (list each "
+                          "local filter once)");
+      inputs_.push_back(in.node);
+    }
     // Every input that names its model must name the same one, and the node predicts with it.
     const InputInfo* first = nullptr;
     for (const InputInfo& in : inputs) {

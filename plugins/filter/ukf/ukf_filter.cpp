@@ -1,5 +1,7 @@
 // Purpose: filter.ukf — scaled unscented Kalman filter with a Cartesian ENU state (CV, CA or Singer motion) on spherical [r, az, el(, rdot)] measurements.
 #include "estimation/cartesian_radar_estimator.hpp"
+#include "estimation/ekf_radar_update.hpp"
+#include "estimation/zenith_guard.hpp"
 #include "sigma_spherical.hpp"
 #include "unscented_transform.hpp"
 
@@ -44,15 +46,18 @@ class UnscentedKalmanFilter final
   UnscentedKalmanFilter(cartesian_filter::Settings s, UnscentedSettings u)
       : Base(std::move(s)), weights_(ukf::ScaledWeights::make(N, u.alpha, u.beta, u.kappa)) {}
 
-  static std::vector<std::string> counter_names() { return {}; }
+  static std::vector<std::string> counter_names() { return {"azimuth_dropped"}; }
   // Spherical only: a 2-D radar's track has a zero-variance z (cartesian_radar_state.hpp), for which
   // the sigma points' Cholesky factor does not exist.
   static constexpr FrameMask kFrames = mask(Frame::Spherical);
 
  private:
+  enum Counter { kAzimuthDropped };
+
   void on_start_run() {
-    jitter_count_ = spread_clamped_count_ = updates_ = 0;
+    jitter_count_ = spread_clamped_count_ = updates_ = relinearised_count_ = 0;
     max_jitter_ = 0.0;
+    zenith_reported_ = false;
   }
 
   void on_end_run_report() {
@@ -68,12 +73,55 @@ class UnscentedKalmanFilter final
                  " made R plus the unscented spread indefinite (P - K S K' could lose definiteness) at " +
                  std::to_string(spread_clamped_count_) + " of " + std::to_string(updates_) +
                  " updates; its negative part was removed there (see alpha, beta, kappa)");
+    if (relinearised_count_ > 0) this->warn(cartesian_filter::relinearised_text(relinearised_count_, updates_));
+  }
+
+  // The azimuth dropped near the zenith (zenith_guard.hpp, as filter.ekf drops it): counted, and
+  // reported once per run.
+  void dropped_azimuth(const Measurement& m) {
+    this->count(kAzimuthDropped);
+    if (zenith_reported_) return;
+    this->warn("target near the zenith at t=" + std::to_string(m.time) +
+               " s: azimuth not used (the zenith is within 3 sigma of the prediction, where the azimuth may flip by "
+               "pi between sigma points); counted in the summary, reported once per run");
+    zenith_reported_ = true;
+  }
+
+  // A prior much wider than the measurement (cartesian_filter::prior_much_wider; a huge q) whose
+  // sigma points reach the zenith: they sample h where the target cannot be, around and across the
+  // sensor (issue 27: q = 1e12 m2/s3 gave a RMSE of 28 000 km), so the update is filter.ekf's
+  // iterated one there (the same code), counted and reported at the end of the run.
+  template <int M>
+  bool iterated_correct(const Measurement& m, const Eigen::Matrix<double, M, M>& R) {
+    cartesian_filter::EkfInnovation<M> in;
+    const cartesian_filter::EkfOutcome outcome =
+        cartesian_filter::ekf_radar_iterated_update<N, M>(x_, P_, idx_, m, R, in);
+    if (outcome == cartesian_filter::EkfOutcome::AtSensor) {
+      this->warn("predicted position at the sensor at t=" + std::to_string(m.time) +
+                 " s: no direction to linearise about; measurement not used");
+      return false;
+    }
+    ++relinearised_count_;
+    if (in.azimuth_dropped) dropped_azimuth(m);
+    if (outcome == cartesian_filter::EkfOutcome::Used) {
+      this->template accept_update<M>(in.nu, in.S, in.nis);
+      return true;
+    }
+    this->warn("innovation covariance not positive definite at t=" + std::to_string(m.time) +
+               " s; measurement not used");
+    return false;
   }
 
   template <int M>
   bool correct(const Measurement& m) {
     using MatM = Eigen::Matrix<double, M, M>;
     ++updates_;
+    // The zenith within 3 sigma of the prediction (zenith_guard.hpp): the azimuth is dropped below,
+    // or, on a prediction much wider than the measurement, the measurement decides (iterated).
+    const Vec3 d = frame_to_sensor(m, Layout::position(x_) - m.sensor_position);
+    const bool zenith = cartesian_filter::azimuth_unusable(d, cartesian_filter::horizontal_covariance<N>(P_, idx_, m));
+    if (zenith && cartesian_filter::prior_much_wider<N, M>(x_, P_, idx_, m, MatM(R_.template topLeftCorner<M, M>())))
+      return iterated_correct<M>(m, MatM(R_.template topLeftCorner<M, M>()));
     MatN L;
     const double jitter = ukf::guarded_cholesky<N>(P_, L);
     if (jitter < 0.0) {
@@ -89,8 +137,7 @@ class UnscentedKalmanFilter final
     // reads the position (and, with the range rate, the velocity): a column of L that moves
     // neither gives h(x) itself (the last one, which moves only the last acceleration).
     // A tilted sensor (Measurement::sensor_axes) sees the centre and the offsets in its own axes.
-    const ukf::SphericalNearCentre<M> near(frame_to_sensor(m, Layout::position(x_) - m.sensor_position),
-                                           frame_to_sensor(m, Layout::velocity(x_)), m.azimuth);
+    const ukf::SphericalNearCentre<M> near(d, frame_to_sensor(m, Layout::velocity(x_)), m.azimuth);
     constexpr int kRead = M == 4 ? 6 : 3;
     const double c = weights_.spread;
     typename ukf::SphericalNearCentre<M>::template Batch<2 * N> points;
@@ -129,7 +176,7 @@ class UnscentedKalmanFilter final
     ukf::MeasurementMoments<N, M> ut;
     ukf::moments_from_points<N, M>(near.centre(), zp, zm, L, weights_, ut, false);
     const SphericalVec<M> z = m.value.template head<M>();
-    const SphericalVec<M> nu = spherical_residual<M>(z, ut.mean);
+    SphericalVec<M> nu = spherical_residual<M>(z, ut.mean);
     // The Joseph form with the statistically linearised H and R + extra gives the textbook
     // UKF's gain P_xz S^-1 and its P - K S K', but as a sum of two positive semi-definite
     // terms (unscented_transform.hpp; docs/filters.md).
@@ -142,6 +189,15 @@ class UnscentedKalmanFilter final
       R = R_.template topLeftCorner<M, M>();
       R += eig.eigenvectors() * eig.eigenvalues().cwiseMax(0.0).asDiagonal() * eig.eigenvectors().transpose();
       ++spread_clamped_count_;
+    }
+    // Near the zenith the sigma points straddle it and their azimuths differ by up to pi: their
+    // mean and spread describe nothing (issue 27: an exact zenith pass gave RMSE 246 m, ANEES
+    // 5 119, where filter.ekf gives 4.6 m). The azimuth is dropped as filter.ekf drops it (the same
+    // test, zenith_guard.hpp): zero column of G (H = G' L^-1), zero innovation, R decorrelated.
+    if (zenith) {
+      ut.G.col(1).setZero();
+      cartesian_filter::drop_azimuth_noise<M>(nu, R);
+      dropped_azimuth(m);
     }
     // H = G' L^-1 is never formed: P H' = L L' H' = L G (L lower triangular), H P H' = G' G.
     // Column by column (P H')(:, k) = sum_j G(j, k) L(:, j): whole columns of L (zero above the
@@ -165,7 +221,8 @@ class UnscentedKalmanFilter final
   }
 
   ukf::ScaledWeights weights_;
-  int jitter_count_ = 0, spread_clamped_count_ = 0, updates_ = 0;
+  int jitter_count_ = 0, spread_clamped_count_ = 0, updates_ = 0, relinearised_count_ = 0;
+  bool zenith_reported_ = false;
   double max_jitter_ = 0.0;
 };
 
@@ -214,7 +271,10 @@ void register_components(Registrar& r) {
       "W0c = W0m + 1 - alpha^2 + beta, Wi = 1/(2(n+lambda)). Azimuths are averaged relative to the centre point's "
       "(no +-pi cut) and every residual's azimuth is wrapped to (-pi, pi]. Update in Joseph form with the "
       "statistically linearised H = P_zx P^-1 and R plus the unexplained spread (equal to P - K S K', kept "
-      "positive semi-definite). Defaults alpha 1, beta 2, kappa 3 - n: sigma points at sqrt(3) sigma (the Gaussian's "
+      "positive semi-definite). Near the zenith the azimuth is dropped as filter.ekf drops it (the same test: the "
+      "zenith within 3 sigma of the prediction; counted as azimuth_dropped); where that prediction's horizontal "
+      "variance also exceeds 100 times the measurement's (a huge q) it is updated by filter.ekf's iterated update (reported at the "
+      "end of the run). Defaults alpha 1, beta 2, kappa 3 - n: sigma points at sqrt(3) sigma (the Gaussian's "
       "fourth moment, Julier & Uhlmann 2004) and non-negative covariance weights for n <= 9."
       " Several inputs (up to 8 radars, each at its own site with its own noise, rate and biases): the measurements are used one after another in time order, equal time stamps in the engine's delivery order (the order of the radars' declaration when they share a truth source); a tilted sensor (a geodetic site away from the frame's origin) is measured in its own axes; the summary then gives updates.<input> and nis_mean.<input> (mean NIS per element with its 95 % chi-square band) per sensor. See docs/filters.md.";
   d.accepts = mask(ItemKind::Measurement);

@@ -49,12 +49,8 @@ EkfOutcome ekf_polar_linearise(const Eigen::Matrix<double, N, 1>& x, const Eigen
   MatM R = R_measured;
   if (sing == SphericalSingularity::Zenith) {  // an infinitely uncertain azimuth, as in condition_near_zenith
     out.azimuth_dropped = true;
-    const double raz = R(1, 1);
     J.row(1).setZero();
-    nu(1) = 0.0;
-    R.row(1).setZero();
-    R.col(1).setZero();
-    R(1, 1) = raz > 0.0 ? raz : 1.0;
+    drop_azimuth_noise<M>(nu, R);
   }
   radar_gain_terms<N, M>(P, idx, m, M == 3 ? 2 : -1, J, R, PHt, out.S);
   out.nu = nu;

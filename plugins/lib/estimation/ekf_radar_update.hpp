@@ -1,6 +1,7 @@
 // Purpose: the EKF measurement update of a Cartesian radar state on [r, az, el(, rdot)] (filter.ekf and each mode of filter.imm): analytic Jacobian, zenith conditioning, structured Joseph update.
 #pragma once
 
+#include "zenith_guard.hpp"
 #include "zenith_linearisation.hpp"
 
 #include <trackflow/items.hpp>
@@ -8,6 +9,8 @@
 #include <trackflow/spherical_measurement.hpp>
 
 #include <Eigen/Core>
+
+#include <string>
 
 namespace trackflow::cartesian_filter {
 
@@ -26,6 +29,7 @@ struct EkfInnovation {
   double nis = 0.0;
   double det_S = 0.0;  // det S, from the update's Cholesky factor
   bool azimuth_dropped = false, azimuth_deweighted = false;
+  bool relinearised = false;  // the iterated update below was used (a prior much wider than the measurement)
 };
 
 // Curvature of the angles over the predicted horizontal uncertainty (zenith_linearisation.hpp):
@@ -37,24 +41,14 @@ template <int N, int M>
 void condition_near_zenith(const Eigen::Matrix<double, N, N>& P, const int idx[6], const Measurement& m, const Vec3& d,
                            SphericalSingularity sing, SphericalJacobian<M>& J, SphericalVec<M>& nu,
                            Eigen::Matrix<double, M, M>& R, EkfInnovation<M>& out) {
-  Eigen::Matrix2d Ph;
-  Ph << P(idx[0], idx[0]), P(idx[0], idx[1]), P(idx[1], idx[0]), P(idx[1], idx[1]);
-  if (!m.sensor_level) {  // the horizontal block in the sensor's own axes
-    Mat3 Pp;
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) Pp(i, j) = P(idx[i], idx[j]);
-    Ph = (m.sensor_axes.transpose() * Pp * m.sensor_axes).template topLeftCorner<2, 2>();
-  }
+  const Eigen::Matrix2d Ph = horizontal_covariance<N>(P, idx, m);
   const ekf::AngleCurvature curvature = ekf::angle_curvature_variance(d, Ph, kZenithFraction * d.norm());
   const double raz = R(1, 1);
   R(2, 2) += curvature.elevation;
   out.azimuth_dropped = sing == SphericalSingularity::Zenith || curvature.azimuth_unusable;
   if (out.azimuth_dropped) {
     J.row(1).setZero();
-    nu(1) = 0.0;
-    R.row(1).setZero();
-    R.col(1).setZero();
-    R(1, 1) = raz > 0.0 ? raz : 1.0;
+    drop_azimuth_noise<M>(nu, R);
   } else {
     R(1, 1) += curvature.azimuth;
     out.azimuth_deweighted = curvature.azimuth > raz;
@@ -106,16 +100,23 @@ void radar_gain_terms(const Eigen::Matrix<double, N, N>& P, const int idx[6], co
 // conditioned), S's lower triangle and P H'; it changes nothing, so a track's predicted measurement
 // (Estimator::predict_measurement, with z = 0: nu = -h) is the update's own linearisation, without
 // a copy of the estimator.
+// `at` (the iterated update below): linearise about that state instead of x, with the iterated
+// EKF's innovation nu = z - h(at) - H (x - at) (the iterated EKF below);
+// `curvature_P`: the covariance of that linearisation point's error, over which the zenith
+// conditioning is taken (P, the prior's, when linearising about the prediction).
 template <int N, int M>
 EkfOutcome ekf_radar_linearise(const Eigen::Matrix<double, N, 1>& x, const Eigen::Matrix<double, N, N>& P,
                                const int idx[6], const Measurement& m, const Eigen::Matrix<double, M, M>& R_measured,
-                               bool curvature, EkfInnovation<M>& out, Eigen::Matrix<double, N, M>& PHt) {
+                               bool curvature, EkfInnovation<M>& out, Eigen::Matrix<double, N, M>& PHt,
+                               const Eigen::Matrix<double, N, 1>* at = nullptr,
+                               const Eigen::Matrix<double, N, N>* curvature_P = nullptr) {
   using MatM = Eigen::Matrix<double, M, M>;
-  out.azimuth_dropped = out.azimuth_deweighted = false;
+  out.azimuth_dropped = out.azimuth_deweighted = out.relinearised = false;
+  const Eigen::Matrix<double, N, 1>& xl = at ? *at : x;
   // In the sensor's own axes (a tilted sensor: Measurement::sensor_axes); J is turned back into
   // the frame's below.
-  const Vec3 d = frame_to_sensor(m, Vec3(x(idx[0]), x(idx[1]), x(idx[2])) - m.sensor_position);
-  const Vec3 v = frame_to_sensor(m, Vec3(x(idx[3]), x(idx[4]), x(idx[5])));
+  const Vec3 d = frame_to_sensor(m, Vec3(xl(idx[0]), xl(idx[1]), xl(idx[2])) - m.sensor_position);
+  const Vec3 v = frame_to_sensor(m, Vec3(xl(idx[3]), xl(idx[4]), xl(idx[5])));
   SphericalJacobian<M> J;  // columns [x y z vx vy vz]
   SphericalVec<M> h;
   const SphericalSingularity sing = spherical_measurement_with_jacobian<M>(d, v, m.azimuth, h, J);
@@ -123,19 +124,90 @@ EkfOutcome ekf_radar_linearise(const Eigen::Matrix<double, N, 1>& x, const Eigen
   const SphericalVec<M> z = m.value.template head<M>();
   SphericalVec<M> nu = spherical_residual<M>(z, h);
   MatM R = R_measured;
-  if (curvature) condition_near_zenith<N, M>(P, idx, m, d, sing, J, nu, R, out);
+  if (curvature) condition_near_zenith<N, M>(curvature_P ? *curvature_P : P, idx, m, d, sing, J, nu, R, out);
   radar_gain_terms<N, M>(P, idx, m, M == 4 ? 3 : -1, J, R, PHt, out.S);
+  if (at)  // J is in the frame's axes now; a dropped azimuth's row is zero, so its nu stays 0
+    for (int k = 0; k < M; ++k)
+      for (int j = 0; j < 6; ++j) nu(k) -= J(k, j) * (x(idx[j]) - xl(idx[j]));
   out.nu = nu;
   return EkfOutcome::Used;
 }
 
+// Whether the predicted horizontal position is much less certain than the measurement's: the
+// trace of the prior's horizontal covariance above kWidePrior times that of the measured point's
+// (at the predicted geometry: along the line of sight (rho/r)^2 var_r + z^2 var_el, across it
+// rho^2 var_az, from R's diagonal). When the zenith conditioning over such a prior (a huge q: 1e12
+// m2/s3 gives an 18 km sigma per 0.1 s step) acts, it drops or de-weights the azimuth although the
+// measurement places the target far from the zenith (issue 27: RMSE 6.2 km where the measurements
+// give ~18 m), and a linearisation about the prediction is poor anyway: the update is iterated
+// (ekf_radar_update below; filter.ukf likewise when the zenith is within its sigma points' reach).
+inline constexpr double kWidePrior = 100.0;
+template <int N, int M>
+bool prior_much_wider(const Eigen::Matrix<double, N, 1>& x, const Eigen::Matrix<double, N, N>& P, const int idx[6],
+                      const Measurement& m, const Eigen::Matrix<double, M, M>& R) {
+  const Vec3 d = frame_to_sensor(m, Vec3(x(idx[0]), x(idx[1]), x(idx[2])) - m.sensor_position);
+  const double rho2 = d.x() * d.x() + d.y() * d.y(), r2 = rho2 + d.z() * d.z();
+  if (!(r2 > 0.0)) return false;
+  const double measured = rho2 / r2 * R(0, 0) + d.z() * d.z() * R(2, 2) + rho2 * R(1, 1);
+  return horizontal_covariance<N>(P, idx, m).trace() > kWidePrior * measured;
+}
+
+// The iterated EKF (Bar-Shalom, Li & Kirubarajan 2001 ch. 10, the iterated EKF; Bell & Cathey,
+// IEEE TAC 38(2), 1993: each iteration is a Gauss-Newton step on the MAP cost): linearise about x_i, x_{i+1} = x + K_i (z - h(x_i) - H_i (x - x_i)), from x_0 = x
+// (the plain EKF's step), until the position moves by less than kIterationTolerance of the range
+// or after kMaxIterations. The final step is linearised about the last iterate with the zenith
+// conditioning taken over the covariance of its error (the last pass's posterior: the error of a
+// point fixed by the measurement, not the prior's), and updates x, P in Joseph form with that H.
+inline constexpr int kMaxIterations = 10;
+inline constexpr double kIterationTolerance = 1e-9;
+template <int N, int M>
+EkfOutcome ekf_radar_iterated_update(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double, N, N>& P,
+                                     const int idx[6], const Measurement& m,
+                                     const Eigen::Matrix<double, M, M>& R_measured, EkfInnovation<M>& out) {
+  Eigen::Matrix<double, N, 1> xi = x, x1;
+  Eigen::Matrix<double, N, N> P1;
+  Eigen::Matrix<double, N, M> PHt;
+  EkfInnovation<M> pass;
+  for (int it = 0; it < kMaxIterations; ++it) {
+    if (ekf_radar_linearise<N, M>(x, P, idx, m, R_measured, false, pass, PHt, &xi) == EkfOutcome::AtSensor)
+      return EkfOutcome::AtSensor;
+    x1 = x;
+    P1 = P;
+    if (!joseph_update_cross<N, M>(x1, P1, pass.nu, PHt, pass.S, pass.nis)) return EkfOutcome::NotPositiveDefinite;
+    const Vec3 step(x1(idx[0]) - xi(idx[0]), x1(idx[1]) - xi(idx[1]), x1(idx[2]) - xi(idx[2]));
+    const double range = (Vec3(x1(idx[0]), x1(idx[1]), x1(idx[2])) - m.sensor_position).norm();
+    xi = x1;
+    if (!(step.norm() > kIterationTolerance * range)) break;
+  }
+  if (ekf_radar_linearise<N, M>(x, P, idx, m, R_measured, true, out, PHt, &xi, &P1) == EkfOutcome::AtSensor)
+    return EkfOutcome::AtSensor;
+  out.relinearised = true;
+  if (joseph_update_cross<N, M>(x, P, out.nu, PHt, out.S, out.nis, nullptr, &out.det_S)) return EkfOutcome::Used;
+  return EkfOutcome::NotPositiveDefinite;
+}
+
+// What filter.ekf and filter.ukf report at the end of a run in which the iterated update was used.
+inline std::string relinearised_text(int count, int updates) {
+  return "predicted horizontal uncertainty more than " + std::to_string(static_cast<int>(kWidePrior)) +
+         " times the measurement's (in variance) at " + std::to_string(count) + " of " + std::to_string(updates) +
+         " updates: the update was iterated about the measured position (iterated EKF) there instead of linearised "
+         "about the prediction (see q)";
+}
+
+// `iterate`: whether a prior much wider than the measurement may take the iterated update
+// (filter.ekf); filter.imm's modes pass false: their likelihoods and the gate are the single
+// linearisation's, and the IMM's results stay what they were.
 template <int N, int M>
 EkfOutcome ekf_radar_update(Eigen::Matrix<double, N, 1>& x, Eigen::Matrix<double, N, N>& P, const int idx[6],
                             const Measurement& m, const Eigen::Matrix<double, M, M>& R_measured, bool curvature,
-                            EkfInnovation<M>& out) {
+                            EkfInnovation<M>& out, bool iterate = true) {
   Eigen::Matrix<double, N, M> PHt;
   if (ekf_radar_linearise<N, M>(x, P, idx, m, R_measured, curvature, out, PHt) == EkfOutcome::AtSensor)
     return EkfOutcome::AtSensor;
+  // The zenith conditioning acted on a prediction much wider than the measurement: the measurement,
+  // not the prior, says where the target is (and whether it is near the zenith).
+  if (iterate && (out.azimuth_dropped || out.azimuth_deweighted) && prior_much_wider<N, M>(x, P, idx, m, R_measured))
+    return ekf_radar_iterated_update<N, M>(x, P, idx, m, R_measured, out);
   if (joseph_update_cross<N, M>(x, P, out.nu, PHt, out.S, out.nis, nullptr, &out.det_S)) return EkfOutcome::Used;
   return EkfOutcome::NotPositiveDefinite;
 }

@@ -13,6 +13,7 @@
 
 #include <cmath>
 #include <limits>
+#include <numbers>
 #include <string>
 
 namespace trackflow {
@@ -343,9 +344,14 @@ void register_components(Registrar& r) {
                                  "four-horn amplitude comparison (eq 2-1..2-12, non-linear off boresight) or an ideal "
                                  "linear discriminator")
           .def("four_horn"),
-      ParamSpec::real("beamwidth", dim::angle, "3 dB beamwidth theta_B (not in the paper; AN/FPS-16: 1.1 deg)")
+      // A tracking antenna's pencil beam: 0.2-5 deg in practice (AN/FPS-16 1.1 deg); eq 2-1's
+      // Gaussian-like pattern is a small-angle model, so past 30 deg it no longer describes a
+      // monopulse antenna (issue 27: 1e6 deg was accepted).
+      ParamSpec::real("beamwidth", dim::angle,
+                      "3 dB beamwidth theta_B, at most 30 deg (a pencil beam; not in the paper; AN/FPS-16: 1.1 deg)")
           .def("1.1 deg")
-          .positive(),
+          .positive()
+          .at_most(30.0 * std::numbers::pi / 180.0),
       ParamSpec::real("beamwidth_constant", dim::none, "four_horn: k_theta of eq 2-1 (AN/FPS-16: 1.19)")
           .def("1.19")
           .positive()

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include <trackflow/data_files.hpp>
+#include <trackflow/number_range.hpp>
 #include <trackflow/number_text.hpp>
 #include <trackflow/geometry.hpp>
 #include <trackflow/common_params.hpp>
@@ -609,6 +610,10 @@ class CsvSource final : public Generator {
         case csv::CellStatus::Ok: return true;
         case csv::CellStatus::Empty: return complain(truncated, "empty value where a number is expected", c);
         case csv::CellStatus::NotFinite: return complain("", "NaN or infinite value", c);
+        case csv::CellStatus::OutOfRange:
+          return complain("", std::string("number ") +
+                                  number_range::describe(number_range::classify(fields[c.index])),
+                          c);
         case csv::CellStatus::Malformed: return complain(truncated, "not a number", c);
       }
       return false;
@@ -645,6 +650,10 @@ class CsvSource final : public Generator {
       if (m.value(0) < 0.0) return complain("", "negative range", value_[0]);
       if (m.frame == Frame::Spherical && std::fabs(m.value(2)) > std::numbers::pi / 2 * (1 + 1e-12))
         return complain("", "elevation beyond +-90 deg", value_[2]);
+      // A log writes its azimuths in [0, 360) or (-180, 180] deg; one beyond a full turn (1e300,
+      // accepted and wrapped before, issue 27) is a corrupt cell, refused as the elevation above.
+      if (std::fabs(m.value(1)) > 2 * std::numbers::pi * (1 + 1e-12))
+        return complain("", "azimuth beyond +-360 deg", value_[1]);
       m.value(1) = wrap_angle(m.value(1));
     }
     if (range_rate_.read()) {
@@ -822,8 +831,9 @@ void register_components(Registrar& r) {
   d.doc = "The whole file is read and checked when the pipeline is built, so `trackflow validate` also finds data "
           "problems; each run then streams the rows from the file again through a buffer of the longest line, so "
           "memory does not grow with the length of the log (a file rewritten while the pipeline runs is an error). "
-          "Each bad row (not a number, NaN/inf, wrong field count, negative range, time going backwards, "
-          "truncated last line) is reported as FILE:LINE; with on_bad_row: skip it is left out and counted. "
+          "Each bad row (not a number, NaN/inf, a number beyond a double's range (too large, or too small: an "
+          "underflow such as 1e-400), wrong field count, negative range, an elevation beyond +-90 deg or an azimuth "
+          "beyond +-360 deg, time going backwards, truncated last line) is reported as FILE:LINE; with on_bad_row: skip it is left out and counted. "
           "Accepts CRLF line endings and double-quoted fields without embedded commas. Metrics: rows (data rows "
           "read), skipped_rows.\n"
           "content: detections replays the log as scans (Scan items) for a tracker: consecutive rows of one scan "

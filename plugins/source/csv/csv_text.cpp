@@ -156,7 +156,7 @@ CellStatus parse_real(std::string_view cell, double& value) {
   const auto [end, ec] = std::from_chars(digits.data(), digits.data() + digits.size(), v);
   if (end != digits.data() + digits.size()) return CellStatus::Malformed;
   // from_chars reports out-of-range values (1e999) as an error without a value.
-  if (ec == std::errc::result_out_of_range) return CellStatus::NotFinite;
+  if (ec == std::errc::result_out_of_range) return CellStatus::OutOfRange;
   if (ec != std::errc()) return CellStatus::Malformed;
   if (!std::isfinite(v)) return CellStatus::NotFinite;
   value = v;

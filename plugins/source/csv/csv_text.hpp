@@ -69,7 +69,8 @@ bool is_blank(std::string_view s);
 // otherwise what is wrong with it.
 std::string split_fields(std::string_view line, std::vector<std::string_view>& fields);
 
-enum class CellStatus { Ok, Empty, Malformed, NotFinite };
+// OutOfRange: a decimal number beyond a double's range (1e999, 1e-400): number_range.hpp says which end.
+enum class CellStatus { Ok, Empty, Malformed, NotFinite, OutOfRange };
 
 // The whole cell must be a decimal number ("12", "-3.5e2", "+4"); NaN and infinities are
 // reported separately because they parse but must never reach a filter.
