@@ -36,7 +36,7 @@ TEST_CASE("effective sample size of white and AR(1) series") {
   CHECK(effective_sample_size({1.0, 2.0, 3.0}) == 3);
 }
 
-TEST_CASE("binomial acceptance is the lower quantile of the binomial") {
+TEST_CASE("binomial acceptance is the binomial lower quantile") {
   for (int n : {1, 5, 7, 20, 90, 600}) {
     for (double confidence : {0.9, 0.95, 0.99}) {
       // Direct: the smallest k with P(X <= k) >= 1 - confidence, the probabilities summed by hand.
@@ -65,7 +65,7 @@ TEST_CASE("binomial acceptance is the lower quantile of the binomial") {
   CHECK(passed / 4000.0 <= 0.985);  // a discrete quantile: at least the confidence, not far above
 }
 
-TEST_CASE("time average degrees of freedom count runs steps and correlation") {
+TEST_CASE("time-average dof counts runs steps and correlation") {
   // K steps of n M dof each: K n M; correlated, divided by tau = K / effective.
   CHECK(time_average_dof(std::vector<double>(600, 1200.0), 600) == Approx(600 * 1200.0));
   CHECK(time_average_dof(std::vector<double>(600, 1200.0), 60) == Approx(60 * 1200.0));
