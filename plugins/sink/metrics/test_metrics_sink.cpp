@@ -748,7 +748,7 @@ Summary nees_study(const std::function<double(int)>& scale) {
 // Issue 25: a manoeuvring study printed "anees 0.906 inside [0.89, 1.116]" while 4.4 % of its 90
 // steps were inside their band: pessimistic most of the time, overconfident through the turn.
 // Both tests now say outside; a consistent estimator with the same correlated errors passes both.
-TEST_CASE("consistency: a time average of wrong steps is not consistent") {
+TEST_CASE("consistency: time-averaged wrong steps are inconsistent") {
   const Summary wrong = nees_study([](int k) { return k >= 60 && k < 80 ? 2.1 : 0.55; });
   INFO("anees " << value(wrong, "anees") << " steps in band " << value(wrong, "anees_steps_in_band"));
   CHECK(value(wrong, "anees") == Approx(0.9).margin(0.1));
