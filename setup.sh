@@ -28,9 +28,10 @@ case "$mode" in
     # The headless-browser test of the report (tests/report/browser.sh) and a font for its
     # screenshot; clang++ and libFuzzer for the fuzz harnesses (tests/fuzz) and the clang build of
     # the SDK; SciPy for the check that the assignment solver's committed SciPy answers are still
-    # SciPy's (plugins/lib/assignment/make_scipy_cases.py --check). Benchmarks are not built for
-    # tests (and mean nothing under ASan).
-    packages+=(chromium fonts-dejavu-core clang libfuzzer-14-dev python3-scipy)
+    # SciPy's (plugins/lib/assignment/make_scipy_cases.py --check); PyYAML for the check that every
+    # YAML snippet in the docs validates (tests/support/docs_snippets.py). Benchmarks are not built
+    # for tests (and mean nothing under ASan).
+    packages+=(chromium fonts-dejavu-core clang libfuzzer-14-dev python3-scipy python3-yaml)
     options=(-DTRACKFLOW_BUILD_TESTS=ON -DTRACKFLOW_BUILD_BENCH=OFF)
     ;;
   bench)
@@ -53,6 +54,9 @@ if [ ${#missing[@]} -gt 0 ]; then
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}" >/dev/null
 fi
 
+# Compiler-cache entries relative to the tree, so that another copy of it (the plugin guide's
+# own SDK build in tests/cli/plugin_guide.sh) finds them.
+export CCACHE_BASEDIR="${CCACHE_BASEDIR:-$(pwd -P)}"
 echo "== configuring and building in $BUILD/ ($mode)"
 if [ "$mode" = sanitize ]; then
   # -fno-gnu-unique: plugins' inline statics stay local to each .so (unique symbols would bind
