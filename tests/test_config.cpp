@@ -202,3 +202,35 @@ TEST_CASE("nested component errors point at the nested key") {
   CHECK(e.where().line == 2);
   CHECK_THAT(e.what(), Catch::Contains("not accepted here"));
 }
+
+// Issue 26: a bare angle in the analyst's file is refused, a bare angle in a declaration's default
+// is the plugin author's SI; a value above the declared plausible magnitude is accepted with one
+// warning naming its line, collected only while a collector is installed (the host's graph build).
+TEST_CASE("bare angles and implausible values") {
+  const std::vector<ParamSpec> angle_specs = {
+      ParamSpec::real("sigma_azimuth", dim::angle, "azimuth noise").def("0.001").at_least(0).plausible_up_to(0.3, "too wide?"),
+      ParamSpec::real("clutter_density", dim::length.pow(-1) * dim::angle.pow(-2), "per m rad^2").def("0")};
+  Value bare = load_yaml_string("{ sigma_azimuth: 2 }", "p.yaml");
+  try {
+    validate_params(angle_specs, bare, "radar", bare.loc);
+    FAIL("a bare angle was accepted");
+  } catch (const ConfigError& e) {
+    CHECK_THAT(e.message(), Catch::Contains("p.yaml:1:18: node 'radar': parameter 'sigma_azimuth' is an angle"));
+    CHECK_THAT(e.message(), Catch::Contains("2 rad = 114.592 deg"));
+  }
+  Value defaults = load_yaml_string("{ clutter_density: 1e-6 }", "p.yaml");
+  std::vector<std::string> warnings;
+  auto* previous = trackflow::detail::install_setup_warnings(&warnings);
+  Params p = validate_params(angle_specs, defaults, "radar", defaults.loc);
+  CHECK(p.real("sigma_azimuth") == 0.001);  // the bare default, in rad
+  CHECK(p.real("clutter_density") == 1e-6);  // a density per angle may be bare
+  CHECK(warnings.empty());
+  Value wide = load_yaml_string("{ sigma_azimuth: 0.5 rad }", "p.yaml");
+  (void)validate_params(angle_specs, wide, "radar", wide.loc);
+  (void)validate_params(angle_specs, wide, "radar", wide.loc);  // the same warning is kept once
+  trackflow::detail::install_setup_warnings(previous);
+  REQUIRE(warnings.size() == 1);
+  CHECK(warnings[0] == "p.yaml:1:18: node 'radar': parameter 'sigma_azimuth' = '0.5 rad' is valid but implausible: too wide?");
+  (void)validate_params(angle_specs, wide, "radar", wide.loc);  // no collector: not collected
+  CHECK(warnings.size() == 1);
+}

@@ -151,6 +151,11 @@ void warn_problems(const host::PluginRegistry& reg) {
   for (const auto& p : reg.problems()) std::cerr << "trackflow: warning: plugin not loaded: " << p.str() << "\n";
 }
 
+void warn_setup(const std::vector<std::string>& warnings) {
+  if (!is_root()) return;
+  for (const auto& w : warnings) std::cerr << "trackflow: warning: " << host::printable(w) << "\n";
+}
+
 namespace {
 host::MpiSession* g_mpi = nullptr;
 }

@@ -61,6 +61,8 @@ class OutputFolderLock {
   int fd_ = -1;
 };
 void warn_problems(const host::PluginRegistry& reg);
+// A graph's valid-but-implausible parameters (host::Graph::warnings), on stderr, from rank 0.
+void warn_setup(const std::vector<std::string>& warnings);
 // Parses argv after the command word; prints help and returns false when asked.
 bool parse(int argc, char** argv, po::options_description& opts, po::positional_options_description& pos,
            po::variables_map& vm, const std::string& usage);

@@ -91,6 +91,7 @@ Loaded load_pipeline(const std::string& file, const std::vector<std::string>& se
   if (track_run >= 0 && scene_node && l.reg.find("sink.scene"))
     *scene_node = add_scene_recorder(l.cfg, l.reg, static_cast<std::uint64_t>(track_run));
   l.graph = build_graph(l.cfg, l.reg);
+  warn_setup(l.graph.warnings);
   return l;
 }
 
@@ -326,6 +327,26 @@ void describe_params_text(std::ostream& os, const std::vector<ParamSpec>& ps, co
 constexpr const char* kEstimatorNote =
     "Per-track estimator: yes (the same parameters make the estimator a tracker runs per track).";
 
+// A node of this type as a pipeline writes it: its inputs and its required parameters as
+// placeholders (issue 26: describe opened with prose; an analyst copies this first).
+void describe_example(std::ostream& os, const ComponentDecl& d) {
+  const std::string id = d.type.substr(d.type.rfind('.') + 1);
+  os << "  - id: " << id << "\n    type: " << d.type << "\n";
+  const std::string producer = "<a node producing " + kinds_text(d.accepts) + ">";
+  if (d.max_inputs == 1) os << "    input: " << producer << "\n";
+  else if (d.max_inputs != 0 && d.min_inputs > 0) {
+    os << "    inputs: [" << producer;
+    for (int k = 1; k < std::max(2, d.min_inputs); ++k) os << ", " << producer;
+    os << "]\n";
+  }
+  std::string required;
+  for (const auto& p : d.params)
+    if (p.required) required += (required.empty() ? "" : ", ") + p.name + ": <" + describe_type(p) + ">";
+  if (!required.empty()) os << "    params: { " << required << " }\n";
+  os << "  (" << (required.empty() ? "every parameter has a default" : "the required parameters; the others have defaults")
+     << ": the table below)\n";
+}
+
 void describe(std::ostream& os, const RegisteredType& t, bool md) {
   const auto& d = t.decl;
   if (md) {
@@ -342,12 +363,13 @@ void describe(std::ostream& os, const RegisteredType& t, bool md) {
     os << "\n";
     return;
   }
-  os << d.type << " (" << to_string(d.kind) << ", from " << t.file << ")\n  " << d.summary << "\n";
+  os << d.type << " (" << to_string(d.kind) << ", from " << t.file << ")\n  " << d.summary << "\n\n";
+  describe_example(os, d);
   if (!d.doc.empty()) os << "\n" << d.doc << "\n";
   os << "\ninputs:  " << kinds_text(d.accepts) << " (" << d.min_inputs << " to "
      << (d.max_inputs < 0 ? std::string("any") : std::to_string(d.max_inputs)) << ")\noutputs: " << kinds_text(d.produces)
      << "\n" << (d.create_estimator ? std::string(kEstimatorNote) + "\n" : std::string())
-     << "\nparameters (bare numbers are SI: m, s, rad; or write a unit: 3 mrad, 1.5 km, 40 Hz):\n";
+     << "\nparameters (write a unit: 3 mrad, 1.5 km, 40 Hz; a bare number is SI, m or s, and an angle needs its unit):\n";
   describe_params_text(os, d.params, "  ");
 }
 

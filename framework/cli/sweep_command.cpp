@@ -26,25 +26,30 @@
 #include <limits>
 #include <system_error>
 #include <mutex>
+#include <optional>
 #include <thread>
 
 namespace trackflow::cli {
 namespace {
 
-const char* kUsage = R"(Usage: trackflow sweep FILE --param node.param=v1,v2,... [--param ...] [options]
+const char* kUsage = R"(Usage: trackflow sweep FILE --param node.param=v1,v2,... [--param ...] [--zip] [options]
 
 Runs FILE once per point of the grid (the Cartesian product of the --param lists, first
---param slowest) and prints one row per point with the chosen metrics. Every point uses the
+--param slowest; with --zip the lists move together, point i taking the i-th value of each)
+and prints one row per point with the chosen metrics. Every point uses the
 same seed (common random numbers), so differences between rows come from the parameters.
 Grid points run in parallel on --threads workers (each point's runs on one thread); the table
 does not depend on the thread count. `expect:` checks are not applied in a sweep.
 The --csv file holds numbers in SI with the unit in the column header (radar.sigma_range_m,
-score.position_rmse_m); --report writes an HTML page with each metric against the first
-numeric axis.
+score.position_rmse_m); --report writes an HTML page with each metric against each numeric
+axis that changes it. A parameter path reaches into components and lists of records, as --set
+does: --param 'truth.segments[1].turn_rate=2 deg/s,4 deg/s'.
 
 Example (paper 000 Table 10):
   trackflow sweep pipelines/quickstart.yaml --param kf.q=0.01,0.1,1,10,100 --runs 50 \
       --metric score.position_rmse --metric score.anees --csv q_sweep.csv
+Two filters tuned alike, 4 points (without --zip, 16):
+  trackflow sweep study.yaml --param kf.q=0.1,1,10,100 --param ukf.q=0.1,1,10,100 --zip
 )";
 
 struct MetricRef {
@@ -56,17 +61,45 @@ std::string cell(double v) {
   return number_text::general(v, 6);
 }
 
+// The declaration a parameter path names: "q", "segments[1].turn_rate" (a field of a record),
+// "position[2]" (an element of a list of reals, declared as the list). Null where the path goes
+// through a component (its parameters are its type's, not this node's) or names nothing.
+std::optional<ParamSpec> path_spec(const std::vector<ParamSpec>& params, const std::string& path) {
+  const std::vector<ParamSpec>* level = &params;
+  const ParamSpec* spec = nullptr;
+  std::size_t at = 0;
+  while (at <= path.size()) {
+    const std::size_t dot = std::min(path.find('.', at), path.size());
+    const std::string step = path.substr(at, dot - at);
+    const std::string name = step.substr(0, step.find('['));
+    const bool indexed = name.size() != step.size();
+    spec = nullptr;
+    for (const auto& p : *level)
+      if (p.name == name) spec = &p;
+    if (!spec) return std::nullopt;
+    if (dot == path.size()) {
+      if (!indexed) return *spec;
+      if (spec->type != ParamType::RealList) return std::nullopt;
+      ParamSpec element = *spec;  // one element of a list of reals: a real of the list's dimension
+      element.type = ParamType::Real;
+      return element;
+    }
+    if (!indexed || spec->type != ParamType::Records) return std::nullopt;
+    level = &spec->fields;
+    at = dot + 1;
+  }
+  return std::nullopt;
+}
+
 // An axis' values in SI when its parameter is a real or an integer ("5 m" -> 5, "20 km" ->
 // 20000), with the SI unit; NaN for values that are not one number (lists, choices, text).
 report::SweepAxisView axis_view(const host::SweepAxis& a, const host::Graph& g,
                                 const std::vector<std::vector<host::Override>>& grid, size_t axis) {
   report::SweepAxisView v;
   v.name = a.node + "." + a.param;
-  const ParamSpec* spec = nullptr;
+  std::optional<ParamSpec> spec;
   for (const auto& n : g.nodes)
-    if (n.config.id == a.node)
-      for (const auto& p : n.type->decl.params)
-        if (p.name == a.param) spec = &p;
+    if (n.config.id == a.node) spec = path_spec(n.type->decl.params, a.param);
   const bool numeric = spec && (spec->type == ParamType::Real || spec->type == ParamType::Integer);
   if (numeric && spec->type == ParamType::Real && !spec->dimension.dimensionless()) v.unit = spec->dimension.str();
   for (const auto& point : grid) {
@@ -92,10 +125,12 @@ int cmd_sweep(int argc, char** argv) {
   std::string file, csv_path, report_path;
   std::vector<std::string> params, sets, metric_names;
   std::string runs_text, seed_text, threads_text = "1";
-  bool quiet = false;
+  bool quiet = false, zip = false;
   po::options_description o("trackflow sweep options");
   o.add_options()("help,h", "show this help")("file", po::value(&file), "pipeline YAML file")(
       "param,p", po::value(&params)->composing(), "a grid axis: node.param=v1,v2,... (repeatable)")(
+      "zip", po::bool_switch(&zip),
+      "tie the --param lists (all the same length): point i takes the i-th value of each, instead of the product")(
       "metric,m", po::value(&metric_names)->composing(),
       "node.metric to tabulate (repeatable; default: position_rmse, velocity_rmse and anees of every "
       "node that reports them)")("runs,n", po::value(&runs_text), "Monte Carlo runs per grid point (default: the pipeline's)")(
@@ -134,7 +169,7 @@ int cmd_sweep(int argc, char** argv) {
   }
   std::vector<host::Override> fixed;
   for (const auto& s : sets) fixed.push_back(host::parse_override(s));
-  const auto grid = host::sweep_grid(axes);
+  const auto grid = zip ? host::sweep_zip(axes) : host::sweep_grid(axes);
 
   // Build (and so validate) every point's graph before running any: a bad value fails fast.
   apply_trust(c);
@@ -158,6 +193,12 @@ int cmd_sweep(int argc, char** argv) {
       }
     }
   });
+  // Each distinct warning once, however many grid points share it.
+  std::vector<std::string> warnings;
+  for (const auto& g : graphs)
+    for (const auto& w : g.warnings)
+      if (std::find(warnings.begin(), warnings.end(), w) == warnings.end()) warnings.push_back(w);
+  warn_setup(warnings);
   const std::string out_root =
       vm.count("out") ? vm["out"].as<std::string>() : (std::filesystem::path("out") / base.name).string();
   // Outputs are checked before the grid runs; another trackflow writing into --out is refused.
@@ -274,7 +315,7 @@ int cmd_sweep(int argc, char** argv) {
     width[k] = header[k].size();
     for (const auto& r : rows) width[k] = std::max(width[k], r[k].size());
   }
-  if (!quiet) std::cout << "sweep " << base.name << ": " << grid.size() << " grid points\n";
+  if (!quiet) std::cout << "sweep " << base.name << ": " << grid.size() << " grid points" << (zip && axes.size() > 1 ? " (zipped)" : "") << "\n";
   for (size_t k = 0; k < header.size(); ++k) std::cout << (k ? "  " : "") << std::setw(static_cast<int>(width[k])) << host::printable(header[k]);
   std::cout << "\n";
   for (const auto& r : rows) {
@@ -314,6 +355,7 @@ int cmd_sweep(int argc, char** argv) {
     r.command = command_line(argc, argv);
     r.axes = axis_views;
     r.metrics = metric_views;
+    r.zipped = zip && axes.size() > 1;
     if (!csv_path.empty()) r.files.push_back(csv_path);
     report::write_text_file(report_path, report::render_sweep_report(r));
     if (!quiet) std::cout << "wrote " << report_path << "\n";

@@ -14,6 +14,10 @@ namespace {
 
 constexpr int kWidth = 860, kHeight = 260;
 
+// Labels of a log axis at 1, 2 and 5 times a power of ten only.
+constexpr const char* kLogLabels =
+    "indexof([1, 2, 5], round(datum.value / pow(10, floor(log(datum.value) / LN10)))) >= 0 ? datum.label : ''";
+
 size_t stride_for(size_t n, size_t max_points = kMaxPointsPerLine) {
   return n <= max_points ? 1 : (n + max_points - 1) / max_points;
 }
@@ -100,6 +104,8 @@ PlaneScales plane_scales(const std::vector<const Line*>& lines, bool equal_axes)
 
 }  // namespace
 
+json log_axis() { return {{"labelExpr", kLogLabels}}; }
+
 double round6(double v) {
   if (!std::isfinite(v) || v == 0.0) return v;
   // Shorter than 16 characters: the string stays in its own small buffer, no allocation.
@@ -128,13 +134,14 @@ Chart line_chart(const std::string& title, const std::string& x_title, const std
   c.spec["params"] = json::array({{{"name", "zoom"}, {"select", "interval"}, {"bind", "scales"}}});
   c.spec["encoding"] = {
       {"x", {{"field", "x"}, {"type", "quantitative"}, {"title", x_title}}},
-      {"y", {{"field", "y"}, {"type", "quantitative"}, {"title", y_title}, {"scale", {{"type", log ? "log" : "linear"}, {"zero", false}}}}},
+      {"y", {{"field", "y"}, {"type", "quantitative"}, {"title", y_title}, {"scale", {{"type", log ? "log" : "linear"}, {"zero", false}}},
+             {"axis", log ? log_axis() : json::object()}}},
       {"color", {{"field", "s"}, {"type", "nominal"}, {"title", nullptr}, {"scale", {{"domain", labels(lines)}}}}}};
   return c;
 }
 
-Chart band_chart(const std::string& title, const std::string& y_title, const Line& value, const Line& band_lo,
-                 const Line& band_hi, const std::string& band_label) {
+Chart band_chart(const std::string& title, const std::string& y_title, const std::vector<Line>& values_in,
+                 const Line& band_lo, const Line& band_hi, const std::string& band_label) {
   Chart c;
   c.title = title;
   json band = json::array();
@@ -144,10 +151,15 @@ Chart band_chart(const std::string& title, const std::string& y_title, const Lin
     band.push_back({{"x", round6(band_lo.x[i])}, {"lo", round6(band_lo.y[i])}, {"hi", round6(band_hi.y[i])}});
   }
   json values = json::array();
-  c.line_points = append_points(values, value);
-  c.lines = c.line_points > 0 ? 1 : 0;
+  for (const auto& v : values_in) {
+    const long n = append_points(values, v);
+    if (n > 0) {
+      ++c.lines;
+      c.line_points += n;
+    }
+  }
   c.areas = band.empty() ? 0 : 1;
-  // A log scale when the value leaves the band by far (an inconsistent filter), so both show.
+  // A log scale when a value leaves the band by far (an inconsistent filter), so both show.
   double lo = std::numeric_limits<double>::infinity(), hi = 0.0;
   for (const auto& v : values) {
     lo = std::min(lo, v["y"].get<double>());
@@ -158,14 +170,18 @@ Chart band_chart(const std::string& title, const std::string& y_title, const Lin
     hi = std::max(hi, b["hi"].get<double>());
   }
   const bool log = lo > 0.0 && hi / lo > 20.0;
-  const json yscale = {{"type", log ? "log" : "linear"}, {"zero", false}};
+  json yscale = {{"type", log ? "log" : "linear"}, {"zero", false}};
+  json yaxis = json::object();
+  // A log axis labels only 1-2-5 steps: the default labels every minor tick and they overlap.
+  if (log) yaxis = log_axis();
   c.spec = base_spec(title);
   c.spec["layer"] = json::array(
+      // The band in grey: the filters' lines take the palette's colours, the first of them blue.
       {{{"data", {{"values", band}}},
-        {"mark", {{"type", "area"}, {"opacity", 0.25}, {"color", "#4c78a8"}, {"clip", true}}},
+        {"mark", {{"type", "area"}, {"opacity", 0.35}, {"color", "#bbbbbb"}, {"clip", true}}},
         {"encoding",
          {{"x", {{"field", "x"}, {"type", "quantitative"}, {"title", "time [s]"}}},
-          {"y", {{"field", "lo"}, {"type", "quantitative"}, {"title", y_title}, {"scale", yscale}}},
+          {"y", {{"field", "lo"}, {"type", "quantitative"}, {"title", y_title}, {"scale", yscale}, {"axis", yaxis}}},
           {"y2", {{"field", "hi"}}}}}},
        {{"data", {{"values", values}}},
         {"mark", {{"type", "line"}, {"strokeWidth", 1.4}, {"clip", true}}},
@@ -173,9 +189,8 @@ Chart band_chart(const std::string& title, const std::string& y_title, const Lin
         {"encoding",
          {{"x", {{"field", "x"}, {"type", "quantitative"}}},
           {"y", {{"field", "y"}, {"type", "quantitative"}, {"scale", yscale}}},
-          {"color", {{"field", "s"}, {"type", "nominal"}, {"title", nullptr},
-                     {"scale", {{"range", json::array({"#d62728"})}}}}}}}}});
-  c.caption = "shaded: " + band_label;
+          {"color", {{"field", "s"}, {"type", "nominal"}, {"title", nullptr}, {"scale", {{"domain", labels(values_in)}}}}}}}}});
+  c.caption = "grey: " + band_label;
   return c;
 }
 
@@ -205,8 +220,9 @@ Chart track_chart(const std::string& title, const std::string& x_title, const st
   const int width = kWidth, height = scales.height;
   c.caption = scales.caption;
   json domain = labels(all);
-  // Truth in black, measurements in pale colours, estimates in strong ones.
-  const char* pale[] = {"#9ecae1", "#c7c7c7", "#fdd0a2", "#c7e9c0"};
+  // Truth in black, measurements in light colours (visible, yet behind the lines), estimates in
+  // strong ones.
+  const char* pale[] = {"#6baed6", "#969696", "#fdae6b", "#74c476"};
   const char* strong[] = {"#d62728", "#1f77b4", "#2ca02c", "#ff7f0e", "#9467bd", "#8c564b", "#e377c2"};
   json range = json::array();
   size_t np = 0, ns = 0;
@@ -219,7 +235,7 @@ Chart track_chart(const std::string& title, const std::string& x_title, const st
   json color = {{"field", "s"}, {"type", "nominal"}, {"title", nullptr}, {"scale", {{"domain", domain}, {"range", range}}}};
   c.spec["layer"] = json::array(
       {{{"data", {{"values", point_values}}},
-        {"mark", {{"type", "point"}, {"filled", true}, {"size", 6}, {"opacity", 0.5}, {"clip", true}}},
+        {"mark", {{"type", "point"}, {"filled", true}, {"size", 10}, {"opacity", 0.7}, {"clip", true}}},
         {"encoding",
          {{"x", {{"field", "x"}, {"type", "quantitative"}, {"title", x_title}, {"scale", xscale}}},
           {"y", {{"field", "y"}, {"type", "quantitative"}, {"title", y_title}, {"scale", yscale}}},

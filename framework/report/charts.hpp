@@ -38,9 +38,10 @@ inline constexpr size_t kMaxPointsPerLine = 1500;
 Chart line_chart(const std::string& title, const std::string& x_title, const std::string& y_title,
                  const std::vector<Line>& lines, bool log_y = false);
 
-// A value against time inside its shaded two-sided band (ANEES, ANIS).
-Chart band_chart(const std::string& title, const std::string& y_title, const Line& value, const Line& band_lo,
-                 const Line& band_hi, const std::string& band_label);
+// Values against time (one line per filter, on one scale) inside their shared two-sided band,
+// shaded grey (ANEES, ANIS).
+Chart band_chart(const std::string& title, const std::string& y_title, const std::vector<Line>& values,
+                 const Line& band_lo, const Line& band_hi, const std::string& band_label);
 
 // A path in a plane (ground track x-y, or altitude against time): `paths` drawn as lines in
 // time order, `points` as small symbols (measurements); equal axis scales when `equal_axes`.
@@ -78,6 +79,9 @@ struct GraphEdgeView {
 };
 Chart graph_chart(const std::vector<GraphNodeView>& nodes, const std::vector<GraphEdgeView>& edges);
 
+// The axis of a log scale: labels at 1, 2 and 5 times a power of ten only (the default labels
+// every minor tick, and they overlap).
+json log_axis();
 // Rounds to 6 significant digits so the page stays small (the CSV files keep full precision).
 double round6(double v);
 

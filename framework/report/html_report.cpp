@@ -229,7 +229,10 @@ std::string header_html(const host::PipelineConfig& c, const std::string& kind, 
 // The recorders the report adds: drawn from, not shown as the analyst's nodes.
 using Hidden = std::set<std::string>;
 
-void pipeline_section(Page& page, const host::Graph& g, const Hidden& hidden) {
+// swept: node id -> the parameters a sweep varies, marked in the table (the values shown are the
+// first grid point's, not fixed ones).
+void pipeline_section(Page& page, const host::Graph& g, const Hidden& hidden,
+                      const std::map<std::string, std::vector<std::string>>& swept = {}) {
   page.html("<h2>Pipeline</h2>\n");
   std::vector<GraphNodeView> nodes;
   std::vector<int> view_index(g.nodes.size(), -1);
@@ -248,6 +251,13 @@ void pipeline_section(Page& page, const host::Graph& g, const Hidden& hidden) {
     if (g.nodes[i].attach_to >= 0) edges.push_back({view_index[i], view_index[static_cast<size_t>(g.nodes[i].attach_to)], true});
   }
   page.chart(graph_chart(nodes, edges));
+  const auto swept_text = [&](const std::string& id) {
+    const auto it = swept.find(id);
+    if (it == swept.end()) return std::string();
+    std::string names;
+    for (const auto& p : it->second) names += (names.empty() ? "" : ", ") + std::string("<code>") + esc(p) + "</code>";
+    return "<br><b>swept:</b> " + names + " (shown at the first grid point's value; every value is in the table below)";
+  };
   page.html("<table><tr><th>node</th><th>type</th><th>kind</th><th>inputs</th><th>parameters (as written)</th></tr>\n");
   for (const auto& n : g.nodes) {
     if (hidden.count(n.config.id)) continue;
@@ -257,7 +267,7 @@ void pipeline_section(Page& page, const host::Graph& g, const Hidden& hidden) {
     page.html("<tr><td><b>" + esc(n.config.id) + "</b></td><td><code>" + esc(n.config.type) + "</code></td><td>" +
               to_string(n.type->decl.kind) + "</td><td>" + esc(inputs) + "</td><td><code>" +
               esc(n.config.params.kind == host::Value::Kind::Null ? std::string("defaults") : value_text(n.config.params)) +
-              "</code></td></tr>\n");
+              "</code>" + swept_text(n.config.id) + "</td></tr>\n");
   }
   page.html("</table>\n");
 }
@@ -359,7 +369,48 @@ std::string label_for(const Scored& s, const std::vector<Scored>& all) {
   return same > 1 ? s.filter + " (" + s.node->id + ")" : s.filter;
 }
 
-void error_section(Page& page, const std::vector<Scored>& scored) {
+// The times where a simulated trajectory changes segment (turn onsets and ends): sim.trajectory
+// nodes' segment boundaries, drawn as dashed rules in the plots against time so a peak in the
+// error can be read against the manoeuvre that caused it.
+std::vector<double> segment_boundaries(const host::Graph& g) {
+  std::vector<double> times;
+  for (const auto& n : g.nodes) {
+    if (n.config.type != "sim.trajectory" || !n.params.has("segments")) continue;
+    double t = n.params.has("start_time") ? n.params.real("start_time") : 0.0;
+    const auto& segments = n.params.records("segments");
+    for (size_t i = 0; i + 1 < segments.size(); ++i) {
+      if (segments[i].has("duration")) t += segments[i].real("duration");
+      if (std::find(times.begin(), times.end(), t) == times.end()) times.push_back(t);
+    }
+  }
+  std::sort(times.begin(), times.end());
+  if (times.size() > 40) times.clear();  // a dense plan: rules would hide the lines
+  return times;
+}
+
+// Adds the boundaries to a plot against time as dashed grey rules (a layer of their own).
+void add_time_rules(Chart& c, const std::vector<double>& times) {
+  if (times.empty()) return;
+  json rules = json::array();
+  for (double t : times) rules.push_back({{"x", round6(t)}});
+  json rule = {{"data", {{"values", rules}}},
+               {"mark", {{"type", "rule"}, {"strokeDash", json::array({4, 3})}, {"color", "#777777"}, {"strokeWidth", 1}}},
+               {"encoding", {{"x", {{"field", "x"}, {"type", "quantitative"}}}}}};
+  if (!c.spec.contains("layer")) {
+    json main = json::object();
+    for (const char* k : {"mark", "encoding", "params"})
+      if (c.spec.contains(k)) {
+        main[k] = c.spec[k];
+        c.spec.erase(k);
+      }
+    c.spec["layer"] = json::array({main});
+  }
+  c.spec["layer"].push_back(rule);
+  c.attributes.emplace_back("data-rules", std::to_string(times.size()));
+  c.caption += std::string(c.caption.empty() ? "" : "; ") + "dashed: where the trajectory's segments change";
+}
+
+void error_section(Page& page, const std::vector<Scored>& scored, const std::vector<double>& rules) {
   if (scored.empty()) return;
   page.html("<h2>Error against time</h2>\n<p class=\"note\">Ensemble over the runs, per time step (after each scoring "
             "node's skip_initial). The measurement RMSE is that of the converted measurements the scoring node "
@@ -378,8 +429,11 @@ void error_section(Page& page, const std::vector<Scored>& scored) {
   }
   Chart c = line_chart("position RMSE against time", "time [s]", "position RMSE [m]", pos, true);
   c.caption = "one line per filter and per measurement stream; log scale; drag to pan, wheel to zoom";
+  add_time_rules(c, rules);
   page.chart(c);
-  page.chart(line_chart("velocity RMSE against time", "time [s]", "velocity RMSE [m/s]", vel, true));
+  Chart v = line_chart("velocity RMSE against time", "time [s]", "velocity RMSE [m/s]", vel, true);
+  add_time_rules(v, rules);
+  page.chart(v);
   for (const auto& s : scored) {
     std::vector<Line> bias;
     for (const char* a : {"x", "y", "z"})
@@ -388,32 +442,70 @@ void error_section(Page& page, const std::vector<Scored>& scored) {
   }
 }
 
-void consistency_section(Page& page, const std::vector<Scored>& scored) {
+// "86 of 90 steps (95.6 %)": counts first, the percentage rounded to what 90 steps can tell.
+std::string steps_inside(size_t in, size_t n) {
+  if (n == 0) return "no steps with a band";
+  return std::to_string(in) + " of " + std::to_string(n) + " steps (" +
+         number_text::fixed(100.0 * static_cast<double>(in) / static_cast<double>(n), 1) + " %)";
+}
+
+// One plot per statistic with every filter on it, on one scale, inside the band they share (the
+// band depends only on the runs at each step and the dimension, so filters scored over the same
+// runs share it; filters whose bands differ, e.g. ANIS of 2-D and 3-D measurements, get a plot per band).
+void consistency_section(Page& page, const std::vector<Scored>& scored, const std::vector<double>& rules) {
   bool any = false;
-  for (const auto& s : scored) {
-    const std::string label = label_for(s, scored);
-    for (const char* m : {"anees", "anis"}) {
-      Line value = column_line(*s.series, m, std::string(m == std::string("anees") ? "ANEES " : "ANIS ") + label);
+  for (const char* m : {"anees", "anis"}) {
+    const std::string name = m == std::string("anees") ? "ANEES" : "ANIS";
+    struct Group {
+      Line lo, hi;
+      std::vector<Line> values;
+      std::vector<std::string> inside;
+    };
+    std::vector<Group> groups;
+    for (const auto& s : scored) {
+      const std::string label = label_for(s, scored);
+      Line value = column_line(*s.series, m, label);
       if (!has_values(value)) continue;
-      if (!any) {
-        page.html("<h2>Consistency against time</h2>\n<p class=\"note\">Per step: average NEES over the runs / 6 "
-                  "(ANEES), average NIS / innovation dimension (ANIS), with the two-sided chi-square band for the "
-                  "number of runs at that step. A consistent filter stays inside the band at about its confidence.</p>\n");
-        any = true;
-      }
       const Line lo = column_line(*s.series, std::string(m) + "_band_lo", "band");
       const Line hi = column_line(*s.series, std::string(m) + "_band_hi", "band");
       size_t in = 0, n = 0;
-      for (size_t i = 0; i < value.y.size(); ++i)
+      for (size_t i = 0; i < value.y.size() && i < lo.y.size() && i < hi.y.size(); ++i)
         if (std::isfinite(value.y[i]) && std::isfinite(lo.y[i]) && std::isfinite(hi.y[i])) {
           ++n;
           in += value.y[i] >= lo.y[i] && value.y[i] <= hi.y[i] ? 1 : 0;
         }
-      Chart c = band_chart(std::string(m == std::string("anees") ? "ANEES" : "ANIS") + " against time - " + label,
-                           m == std::string("anees") ? "ANEES" : "ANIS", value, lo, hi, "chi-square band");
-      c.caption = "shaded: chi-square band for the runs at each step; inside at " +
-                  num(n ? 100.0 * static_cast<double>(in) / static_cast<double>(n) : 0.0) + " % of " +
-                  std::to_string(n) + " steps";
+      const auto same = [](const Line& a, const Line& b) {
+        if (a.x.size() != b.x.size()) return false;
+        for (size_t i = 0; i < a.x.size(); ++i) {
+          const bool fa = std::isfinite(a.y[i]), fb = std::isfinite(b.y[i]);
+          if (a.x[i] != b.x[i] || fa != fb || (fa && std::abs(a.y[i] - b.y[i]) > 1e-9 * std::abs(a.y[i]))) return false;
+        }
+        return true;
+      };
+      Group* g = nullptr;
+      for (auto& x : groups)
+        if (same(x.lo, lo) && same(x.hi, hi)) g = &x;
+      if (!g) g = &groups.emplace_back(Group{lo, hi, {}, {}});
+      g->values.push_back(value);
+      g->inside.push_back(label + ": " + steps_inside(in, n));
+    }
+    if (groups.empty()) continue;
+    if (!any) {
+      page.html("<h2>Consistency against time</h2>\n<p class=\"note\">Per step: average NEES over the runs / 6 "
+                "(ANEES), average NIS / innovation dimension (ANIS), every filter on one scale, with the two-sided "
+                "chi-square band for the number of runs at that step (grey). A consistent filter stays inside the "
+                "band at about its confidence.</p>\n");
+      any = true;
+    }
+    for (const auto& g : groups) {
+      std::string who;
+      if (groups.size() > 1)
+        for (const auto& v : g.values) who += (who.empty() ? " - " : ", ") + v.label;
+      Chart c = band_chart(name + " against time" + who, name, g.values, g.lo, g.hi, "chi-square band for the runs at each step");
+      std::string inside;
+      for (const auto& t : g.inside) inside += (inside.empty() ? "" : "; ") + t;
+      c.caption += "; inside the band: " + inside;
+      add_time_rules(c, rules);
       page.chart(c);
     }
   }
@@ -434,7 +526,29 @@ void annotation_section(Page& page, const std::vector<Scored>& scored) {
       header = true;
     }
     const std::string label = label_for(s, scored);
-    page.chart(line_chart("fraction of runs initialised and updated - " + label, "time [s]", "fraction of runs", fractions));
+    // A fraction that never changes (every run initialised and updated at every step, the usual
+    // case) is said in a line, not drawn as a flat plot.
+    std::vector<Line> varying;
+    std::string constant;
+    for (const auto& f : fractions) {
+      double first = NAN;
+      bool flat = true, seen = false;
+      for (double v : f.y)
+        if (std::isfinite(v)) {
+          if (!seen) first = v;
+          flat = flat && v == first;
+          seen = true;
+        }
+      if (!seen) continue;
+      if (flat) constant += (constant.empty() ? "" : ", ") + f.label + " in " + num(100.0 * first) + " % of the runs";
+      else varying.push_back(f);
+    }
+    if (!constant.empty())
+      page.html("<p class=\"note\">" + esc(label) + ": at every step " + esc(constant) + " (not plotted).</p>\n");
+    if (!varying.empty())
+      page.chart(line_chart("fraction of runs " + std::string(varying.size() == 2 ? "initialised and updated" : varying[0].label) +
+                                " - " + label,
+                            "time [s]", "fraction of runs", varying));
     if (!lines.empty()) {
       Chart c = line_chart("annotations (mean over runs) - " + label, "time [s]", "mean value", lines);
       c.caption = "per channel: mean over the runs of the value the adapters attached to the estimate "
@@ -612,8 +726,9 @@ std::string render_run_report(const RunReport& r) {
   static const std::vector<host::ExpectResult> none;
   summary_section(page, out, r.expects ? *r.expects : none, r.threads, g.config.seed, hidden);
   const auto scored = scored_series(g, out);
-  error_section(page, scored);
-  consistency_section(page, scored);
+  const std::vector<double> rules = segment_boundaries(g);
+  error_section(page, scored, rules);
+  consistency_section(page, scored, rules);
   gospa_section(page, out);
   if (!r.track_node.empty()) track_section(page, g, out, r.track_node, r.track_run);
   if (!r.scene_node.empty()) scene_section(page, out, r.scene_node, r.track_run);
@@ -627,32 +742,64 @@ std::string render_sweep_report(const SweepReport& r) {
   const host::Graph& g = *r.graph;
   Page page;
   page.html(header_html(g.config, "sweep report", r.command));
-  pipeline_section(page, g, Hidden{});
+  std::map<std::string, std::vector<std::string>> swept;
+  for (const auto& a : r.axes) {
+    const auto dot = a.name.find('.');
+    swept[a.name.substr(0, dot)].push_back(a.name.substr(dot + 1));
+  }
+  pipeline_section(page, g, Hidden{}, swept);
   const size_t points = r.metrics.empty() ? 0 : r.metrics.front().value.size();
-  page.html("<h2>Sweep</h2>\n<p>" + std::to_string(points) + " grid points, " + std::to_string(r.runs) +
-            " runs each, the same seed at every point (common random numbers).</p>\n");
-  // The metric against the first numeric axis; one line per combination of the other axes.
-  int x_axis = -1;
-  for (size_t a = 0; a < r.axes.size() && x_axis < 0; ++a)
-    if (std::all_of(r.axes[a].value.begin(), r.axes[a].value.end(), [](double v) { return std::isfinite(v); }))
-      x_axis = static_cast<int>(a);
-  if (x_axis >= 0) {
-    const auto& ax = r.axes[static_cast<size_t>(x_axis)];
-    bool log_x = true;
-    double lo = INFINITY, hi = 0;
-    for (double v : ax.value) {
-      log_x = log_x && v > 0;
-      lo = std::min(lo, v);
-      hi = std::max(hi, v);
+  page.html("<h2>Sweep</h2>\n<p>" + std::to_string(points) + " grid points" +
+            (r.zipped ? std::string(" (zipped: point i takes the i-th value of every axis)") : std::string()) + ", " +
+            std::to_string(r.runs) + " runs each, the same seed at every point (common random numbers).</p>\n");
+  // Each metric against each numeric axis that changes it (one line per combination of the other
+  // axes); a metric no axis changes is listed once, not plotted flat. Zipped axes move together:
+  // they are one x axis, named by all of them, and every metric is one line.
+  const auto numeric = [](const SweepAxisView& a) {
+    return std::all_of(a.value.begin(), a.value.end(), [](double v) { return std::isfinite(v); });
+  };
+  std::vector<size_t> x_axes;
+  for (size_t a = 0; a < r.axes.size(); ++a)
+    if (numeric(r.axes[a]) && (!r.zipped || x_axes.empty())) x_axes.push_back(a);
+  std::string zipped_name;
+  for (const auto& a : r.axes) zipped_name += (zipped_name.empty() ? "" : " = ") + a.name;
+  // The other axes' values at point p, as a label ("" when x is the only axis, or zipped).
+  const auto rest_of = [&](size_t x, size_t p) {
+    std::string rest;
+    if (r.zipped) return rest;
+    for (size_t a = 0; a < r.axes.size(); ++a)
+      if (a != x) rest += (rest.empty() ? "" : ", ") + r.axes[a].name + "=" + r.axes[a].text[p];
+    return rest;
+  };
+  // Does the metric change along axis x, the other axes held? (NaN equals NaN here: a metric
+  // undefined at every point changes nothing.)
+  const auto changes = [&](const SweepMetricView& m, size_t x) {
+    std::map<std::string, double> first;
+    for (size_t p = 0; p < m.value.size(); ++p) {
+      const auto [it, fresh] = first.emplace(rest_of(x, p), m.value[p]);
+      if (!fresh && !(it->second == m.value[p] || (std::isnan(it->second) && std::isnan(m.value[p])))) return true;
     }
-    log_x = log_x && hi / lo >= 100;
-    for (const auto& m : r.metrics) {
+    return false;
+  };
+  std::vector<std::string> constant;
+  for (const auto& m : r.metrics) {
+    bool plotted = false;
+    for (size_t x : x_axes) {
+      if (!changes(m, x)) continue;
+      plotted = true;
+      const auto& ax = r.axes[x];
+      bool log_x = true;
+      double lo = INFINITY, hi = 0;
+      for (double v : ax.value) {
+        log_x = log_x && v > 0;
+        lo = std::min(lo, v);
+        hi = std::max(hi, v);
+      }
+      log_x = log_x && hi / lo >= 100;
       std::map<std::string, Line> by_rest;
       std::vector<std::string> order;
       for (size_t p = 0; p < m.value.size(); ++p) {
-        std::string rest;
-        for (size_t a = 0; a < r.axes.size(); ++a)
-          if (static_cast<int>(a) != x_axis) rest += (rest.empty() ? "" : ", ") + r.axes[a].name + "=" + r.axes[a].text[p];
+        std::string rest = rest_of(x, p);
         if (rest.empty()) rest = m.name;
         if (!by_rest.count(rest)) order.push_back(rest);
         Line& l = by_rest[rest];
@@ -662,17 +809,29 @@ std::string render_sweep_report(const SweepReport& r) {
       }
       std::vector<Line> lines;
       for (const auto& k : order) lines.push_back(by_rest[k]);
-      const std::string xt = ax.name + (ax.unit.empty() ? "" : " [" + ax.unit + "]");
+      const std::string x_name = r.zipped ? zipped_name : ax.name;
+      const std::string xt = x_name + (ax.unit.empty() ? "" : " [" + ax.unit + "]");
       const std::string yt = m.name + (m.unit.empty() ? "" : " [" + m.unit + "]");
-      Chart c = line_chart(m.name + " against " + ax.name, xt, yt, lines);
-      if (log_x) c.spec["encoding"]["x"]["scale"] = {{"type", "log"}};
+      Chart c = line_chart(m.name + " against " + x_name, xt, yt, lines);
+      if (log_x) {
+        c.spec["encoding"]["x"]["scale"] = {{"type", "log"}};
+        c.spec["encoding"]["x"]["axis"] = log_axis();
+      }
       c.spec["mark"]["point"] = true;
       c.symbols = c.line_points;  // a symbol on every point
-      c.caption = log_x ? "log scale on x" : "";
+      c.caption = std::string(log_x ? "log scale on x" : "") +
+                  (r.zipped ? std::string(log_x ? "; " : "") + "zipped axes: point i takes the i-th value of each" : "");
       page.chart(c);
     }
-  } else {
+    if (!plotted) constant.push_back(m.name + " = " + num(m.value.empty() ? NAN : m.value.front()));
+  }
+  if (x_axes.empty())
     page.html("<p class=\"note\">No axis has numeric values only: see the table.</p>\n");
+  else if (!constant.empty()) {
+    std::string list;
+    for (const auto& c : constant) list += (list.empty() ? "" : ", ") + esc(c);
+    page.html("<p class=\"note\">The same at every grid point (no swept parameter changes them), so not plotted: " + list +
+              ".</p>\n");
   }
   page.html("<table><tr>");
   for (const auto& a : r.axes) page.html("<th>" + esc(a.name) + (a.unit.empty() ? "" : " [" + esc(a.unit) + "]") + "</th>");

@@ -43,6 +43,7 @@ struct SweepReport {
   std::vector<SweepAxisView> axes;
   std::vector<SweepMetricView> metrics;
   std::vector<std::string> files;
+  bool zipped = false;  // --zip: the axes move together (point i takes the i-th value of each)
 };
 
 std::string render_sweep_report(const SweepReport& r);

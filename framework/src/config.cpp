@@ -388,6 +388,43 @@ Value load_yaml_file(const std::string& path) {
 
 Value load_yaml_string(const std::string& text, const std::string& name) { return parse_text(text, name); }
 
+namespace {
+
+// One step of an override's parameter path: a name and the list indices after it
+// ("segments[1]" -> segments, {1}).
+struct OverrideStep {
+  std::string name;
+  std::vector<std::size_t> indices;
+};
+
+std::vector<OverrideStep> parse_override_path(const std::string& path, const std::string& what) {
+  std::vector<OverrideStep> steps;
+  std::size_t at = 0;
+  const auto bad = [&](const std::string& why) {
+    return ConfigError(what + ": " + why + " (a path is name, name.name or name[index].name, e.g. truth.segments[1].turn_rate)");
+  };
+  for (;;) {
+    OverrideStep step;
+    while (at < path.size() && path[at] != '.' && path[at] != '[') step.name += path[at++];
+    if (step.name.empty()) throw bad("empty parameter name");
+    while (at < path.size() && path[at] == '[') {
+      const auto close = path.find(']', at);
+      if (close == std::string::npos) throw bad("'[' without ']'");
+      const std::string digits = path.substr(at + 1, close - at - 1);
+      if (digits.empty() || digits.size() > 6 || digits.find_first_not_of("0123456789") != std::string::npos)
+        throw bad("'[" + quote_token(digits) + "]' is not a list index (0, 1, 2, ...)");
+      step.indices.push_back(static_cast<std::size_t>(std::stoul(digits)));
+      at = close + 1;
+    }
+    steps.push_back(std::move(step));
+    if (at == path.size()) return steps;
+    if (path[at] != '.') throw bad("unexpected '" + quote_token(path.substr(at, 1)) + "'");
+    ++at;
+  }
+}
+
+}  // namespace
+
 Override parse_override(const std::string& text) {
   const auto eq = text.find('=');
   const auto dot = text.find('.');
@@ -510,35 +547,57 @@ PipelineConfig parse_pipeline(const Value& root, const std::string& file, const 
       it->params.kind = Value::Kind::Map;
     }
     // A dotted parameter reaches into a component-valued one: --set mtt.estimator.q=1 sets q in
-    // the map under 'estimator'. Every level but the last must already be a map in the file.
+    // the map under 'estimator'; an index reaches into a list: --set truth.segments[1].turn_rate=
+    // '3 deg/s' sets a field of the second record, --set radar.position[2]=10 sets one element.
+    // Every level but the last must already be in the file: an override changes what is there or
+    // adds a parameter to a map, it never invents a list element.
+    const std::string what = "--set " + quote_token(o.node) + "." + quote_token(o.param);
+    const auto steps = parse_override_path(o.param, what);
     Value* target = &it->params;
-    std::string key = o.param;
-    for (std::size_t dot = key.find('.'); dot != std::string::npos; dot = key.find('.')) {
-      const std::string head = key.substr(0, dot);
-      Value* inner = target->find(head);
+    std::string reached = "node '" + quote_token(o.node) + "'";
+    for (std::size_t k = 0; k < steps.size(); ++k) {
+      const OverrideStep& step = steps[k];
+      const bool last = k + 1 == steps.size();
+      if (target->kind != Value::Kind::Map)
+        throw ConfigError(what + ": " + reached + " is not a map of parameters (a dotted name reaches into a component or a record, e.g. --set mtt.estimator.q=1)",
+                          target->loc, o.node);
+      Value* inner = target->find(step.name);
+      if (last && step.indices.empty()) {
+        if (inner) {
+          *inner = std::move(val);
+        } else {
+          target->entries.emplace_back(step.name, std::move(val));
+          target->key_locs.push_back({"--set " + o.node + "." + o.param, 0, 0});
+        }
+        break;
+      }
       if (!inner) {
         std::vector<std::string> keys;
         for (const auto& e : target->entries) keys.push_back(e.first);
-        throw ConfigError("--set " + quote_token(o.node) + "." + quote_token(o.param) + ": node '" +
-                              quote_token(o.node) + "' sets no '" + quote_token(head) + "' to reach into" +
-                              did_you_mean(head, keys) + "; it sets: " + join_some(keys),
-                          it->loc, o.node);
+        throw ConfigError(what + ": " + reached + " sets no '" + quote_token(step.name) + "' to reach into" +
+                              did_you_mean(step.name, keys) + "; it sets: " + join_some(keys),
+                          k == 0 ? it->loc : target->loc, o.node);
       }
-      if (inner->kind != Value::Kind::Map)
-        throw ConfigError("--set " + quote_token(o.node) + "." + quote_token(o.param) + ": '" + quote_token(head) +
-                              "' is not a map of parameters in node '" + quote_token(o.node) +
-                              "' (a dotted name reaches into a component, e.g. --set mtt.estimator.q=1)",
-                          inner->loc, o.node);
+      reached = "'" + quote_token(step.name) + "'";
+      for (std::size_t index : step.indices) {
+        if (inner->kind != Value::Kind::List)
+          throw ConfigError(what + ": " + reached + " is " + inner->describe() + ", not a list to index", inner->loc, o.node);
+        if (index >= inner->items.size())
+          throw ConfigError(what + ": " + reached +
+                                (inner->items.empty() ? std::string(" is an empty list")
+                                 : " has " + std::to_string(inner->items.size()) + " element" +
+                                       (inner->items.size() == 1 ? std::string(" (index 0)")
+                                                                 : "s (indices 0 to " + std::to_string(inner->items.size() - 1) + ")")) +
+                                ", so no [" + std::to_string(index) + "]",
+                            inner->loc, o.node);
+        inner = &inner->items[index];
+        reached += "[" + std::to_string(index) + "]";
+      }
+      if (last) {
+        *inner = std::move(val);
+        break;
+      }
       target = inner;
-      key = key.substr(dot + 1);
-    }
-    if (key.empty())
-      throw ConfigError("--set '" + quote_token(o.node) + "." + quote_token(o.param) + "': empty parameter name");
-    if (Value* existing = target->find(key)) {
-      *existing = std::move(val);
-    } else {
-      target->entries.emplace_back(key, std::move(val));
-      target->key_locs.push_back({"--set " + o.node + "." + o.param, 0, 0});
     }
   }
 

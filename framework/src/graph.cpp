@@ -43,6 +43,13 @@ std::string unknown_type_message(const std::string& type, const PluginRegistry& 
 }
 
 Graph build_graph(PipelineConfig cfg, const PluginRegistry& registry) {
+  // What validation (a declaration's plausible range) and construction (Params::warn) find valid
+  // but seldom meant is collected here, for the CLI to print before anything runs.
+  std::vector<std::string> warnings;
+  struct Uninstall {
+    std::vector<std::string>* previous;
+    ~Uninstall() { trackflow::detail::install_setup_warnings(previous); }
+  } uninstall{trackflow::detail::install_setup_warnings(&warnings)};
   Graph g;
   g.config = std::move(cfg);
   std::map<std::string, int> index;
@@ -236,6 +243,7 @@ Graph build_graph(PipelineConfig cfg, const PluginRegistry& registry) {
   collect_declared_outputs(nullptr);
   g.outputs = std::move(declared);
   check_declared_outputs(g);
+  g.warnings = warnings;
   return g;
 }
 

@@ -2,6 +2,9 @@
 #include <trackflow/estimator.hpp>
 #include <trackflow/params.hpp>
 
+#include <algorithm>
+#include <utility>
+
 namespace trackflow {
 
 const char* to_string(ParamType t) {
@@ -142,5 +145,22 @@ SourceLoc Params::where(std::string_view name) const {
 ConfigError Params::error(std::string_view name, const std::string& message) const {
   return ConfigError("parameter '" + std::string(name) + "': " + message, where(name), node_);
 }
+void Params::warn(std::string_view name, const std::string& message) const {
+  detail::note_setup_warning(error(name, message).message());
+}
+
+namespace detail {
+namespace {
+thread_local std::vector<std::string>* setup_warnings = nullptr;
+}  // namespace
+std::vector<std::string>* install_setup_warnings(std::vector<std::string>* collector) {
+  return std::exchange(setup_warnings, collector);
+}
+void note_setup_warning(const std::string& text) {
+  if (!setup_warnings) return;
+  if (std::find(setup_warnings->begin(), setup_warnings->end(), text) == setup_warnings->end())
+    setup_warnings->push_back(text);
+}
+}  // namespace detail
 
 }  // namespace trackflow

@@ -51,4 +51,21 @@ std::vector<std::vector<Override>> sweep_grid(const std::vector<SweepAxis>& axes
   return grid;
 }
 
+std::vector<std::vector<Override>> sweep_zip(const std::vector<SweepAxis>& axes) {
+  std::vector<std::vector<Override>> grid;
+  if (axes.empty()) return grid;
+  const std::size_t points = axes.front().values.size();
+  for (const auto& a : axes)
+    if (a.values.size() != points)
+      throw ConfigError("--zip: every --param list must have the same length; " + axes.front().node + "." +
+                        axes.front().param + " has " + std::to_string(points) + " values, " + a.node + "." + a.param +
+                        " has " + std::to_string(a.values.size()));
+  if (points > kMaxSweepPoints)
+    throw ConfigError("the sweep has more than " + std::to_string(kMaxSweepPoints) + " points; split it into several sweeps");
+  grid.resize(points);
+  for (std::size_t i = 0; i < points; ++i)
+    for (const auto& a : axes) grid[i].push_back({a.node, a.param, a.values[i]});
+  return grid;
+}
+
 }  // namespace trackflow::host

@@ -38,6 +38,30 @@ std::string range_text(const ParamSpec& s) {
   return hi.empty() ? lo : lo + " and " + hi;
 }
 
+// A bare number for a quantity with an angle in its dimension (an angle, an angular rate) is
+// refused (issue 26): SI would read `sigma_azimuth: 2` as 2 rad (115 deg) and `turn_rate: 3` as
+// 3 rad/s (61 g at 200 m/s), both valid and both almost certainly meant in degrees. A length, a
+// time, or a density per angle (clutter per m*rad^2), given bare is what the SI reading says: those
+// are computed, not read off a data sheet in degrees. Zero needs no unit.
+std::string bare_angle_problem(const ParamSpec& s, const std::string& text, double si) {
+  const std::string si_unit = s.dimension.str();
+  std::string deg_unit = si_unit;
+  for (size_t at = deg_unit.find("rad"); at != std::string::npos; at = deg_unit.find("rad", at + 3))
+    deg_unit.replace(at, 3, "deg");
+  const double deg = si * std::pow(180.0 / std::numbers::pi, s.dimension.angle);
+  const std::string number = quote_token(text);
+  std::string ways = "'" + number + " " + deg_unit + "'";
+  if (s.dimension == dim::angle) ways += ", '" + number + " mrad'";
+  ways += " or '" + number + " " + si_unit + "'";
+  return "parameter '" + s.name + "' is " + (s.dimension == dim::angle ? "an angle" : "a quantity in " + si_unit) +
+         ": write its unit (" + ways + "); a bare " + number + " would be read as " + number + " " + si_unit + " = " +
+         number_text::general(deg, 6) + " " + deg_unit;
+}
+
+// Set while a declaration's default is parsed: a default is the plugin author's SI number, neither
+// an analyst's bare angle to refuse nor an analyst's value to call implausible.
+thread_local bool parsing_default = false;
+
 double parse_real(const ParamSpec& s, const Value& v, const std::string& node) {
   if (!v.is_scalar())
     throw ConfigError("parameter '" + s.name + "' expects a " + describe_type(s) + ", got " + v.describe(), v.loc,
@@ -48,6 +72,8 @@ double parse_real(const ParamSpec& s, const Value& v, const std::string& node) {
   } catch (const std::exception& e) {
     throw ConfigError("parameter '" + s.name + "': " + e.what(), v.loc, node);
   }
+  if (!q.had_unit && q.value != 0 && s.dimension.angle > 0 && !parsing_default)
+    throw ConfigError(bare_angle_problem(s, v.scalar, q.value), v.loc, node);
   if (q.had_unit && q.dimension != s.dimension)
     throw ConfigError("parameter '" + s.name + "' has unit dimension " + s.dimension.str() + ", but '" + quote_token(v.scalar) +
                           "' is " + q.dimension.str(),
@@ -55,6 +81,11 @@ double parse_real(const ParamSpec& s, const Value& v, const std::string& node) {
   if (q.value < s.min || q.value > s.max)
     throw ConfigError("parameter '" + s.name + "' must be " + range_text(s) + ", got '" + quote_token(v.scalar) + "'",
                       v.loc, node);
+  if (std::abs(q.value) > s.plausible_max_abs && !parsing_default)
+    detail::note_setup_warning(ConfigError("parameter '" + s.name + "' = '" + quote_token(v.scalar) +
+                                               "' is valid but implausible: " + s.implausible_hint,
+                                           v.loc, node)
+                                   .message());
   return q.value;
 }
 
@@ -238,7 +269,15 @@ Params validate_params(const std::vector<ParamSpec>& specs, const Value& given, 
       p.set(s.name, parse_value(s, *v, node, types));
     } else if (!s.default_text.empty()) {
       Value dv = load_yaml_string(s.default_text, "default of " + s.name);
-      ParamValue pv = parse_value(s, dv, node, types);
+      parsing_default = true;
+      ParamValue pv;
+      try {
+        pv = parse_value(s, dv, node, types);
+      } catch (...) {
+        parsing_default = false;
+        throw;
+      }
+      parsing_default = false;
       pv.from_default = true;
       p.set(s.name, std::move(pv));
     } else if (s.required) {

@@ -141,6 +141,9 @@ trackflow run bad_nonnumeric --set radar.path=no_such_file.csv
 expect_exit 2 "missing file"
 expect_stderr "parameter 'path'" "missing file"
 expect_stderr "no_such_file.csv" "missing file"
+# The message gives the resolved, absolute path and how a relative one was resolved (issue 26).
+grep -Eq "cannot open '/[^']*/no_such_file\.csv': No such file or directory \(path 'no_such_file\.csv' is read relative to the working directory\)" "$STDERR" ||
+  fail "missing file: stderr does not give the resolved path and how it was resolved: $(cat "$STDERR")"
 
 echo "ok: $CHECKS checks passed"
 exit 0

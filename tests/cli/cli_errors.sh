@@ -43,6 +43,48 @@ base | sed 's/sigma_range: 10 m/sigma_range: 3 mrad/' > "$TMP/wrong_unit.yaml"
 expect_run "wrong unit dimension" 2 "wrong_unit.yaml:13:28: node 'radar': parameter 'sigma_range' has unit dimension m, but '3 mrad' is rad" \
   -- "$TF" validate "$TMP/wrong_unit.yaml"
 
+# Issue 26: a bare number for an angle or an angular rate is refused, with its SI reading; a length
+# given bare stays what SI says, and zero needs no unit.
+base | sed 's/sigma_range: 10 m/sigma_range: 10 m, sigma_azimuth: 2/' > "$TMP/bare_angle.yaml"
+expect_run "a bare angle is refused with its SI reading" 2 "bare_angle.yaml:13:49: node 'radar': parameter 'sigma_azimuth' is an angle: write its unit \('2 deg', '2 mrad' or '2 rad'\); a bare 2 would be read as 2 rad = 114.592 deg" \
+  -- "$TF" validate "$TMP/bare_angle.yaml"
+base | sed 's/segments: .*/segments: [ { type: turn, turn_rate: 3, duration: 5 s } ]/' > "$TMP/bare_turn.yaml"
+expect_run "a bare turn rate is refused with its SI reading" 2 "bare_turn.yaml:9:44: node 'truth': parameter 'turn_rate' is a quantity in rad/s: write its unit \('3 deg/s' or '3 rad/s'\); a bare 3 would be read as 3 rad/s = 171.887 deg/s" \
+  -- "$TF" validate "$TMP/bare_turn.yaml"
+expect_run "--set of a bare angle is refused too" 2 "node 'radar': parameter 'sigma_azimuth' is an angle: write its unit" \
+  -- "$TF" validate "$TMP/ok.yaml" --set radar.sigma_azimuth=0.002
+base | sed 's/segments: .*/segments: [ { type: turn, turn_rate: 0, duration: 5 s } ]/' | sed 's/sigma_range: 10 m/sigma_range: 10/' > "$TMP/bare_zero.yaml"
+expect_run "a bare zero angle and a bare length are accepted" 0 "ok" -- "$TF" validate "$TMP/bare_zero.yaml"
+# ... and a valid value that is seldom meant is a warning at validate (and once at run), not an error.
+base | sed 's/sigma_range: 10 m/sigma_range: 10 m, sigma_azimuth: 0.5 rad/' > "$TMP/wide_angle.yaml"
+expect_run "an angle sigma above 0.3 rad is warned about" 0 "warning: .*wide_angle.yaml:13:49: node 'radar': parameter 'sigma_azimuth' = '0.5 rad' is valid but implausible: an angle noise sigma above 0.3 rad \(17.2 deg\)" \
+  -- "$TF" validate "$TMP/wide_angle.yaml"
+base | sed 's/segments: .*/segments: [ { type: turn, turn_rate: 3 rad\/s, duration: 5 s } ]/' > "$TMP/hard_turn.yaml"
+expect_run "a turn above 30 g is warned about" 0 "warning: .*hard_turn.yaml:9:44: node 'truth': parameter 'turn_rate': segment 1 \(turn\): 171.9 deg/s at 158.1 m/s horizontal speed is a 48.4 g turn, above the 30 g" \
+  -- "$TF" validate "$TMP/hard_turn.yaml"
+"$TF" run "$TMP/hard_turn.yaml" --runs 3 --out "$TMP/hard" --no-progress > "$TMP/hard.log" 2>&1 || fail "a run with a warning failed: $(cat "$TMP/hard.log")"
+[ "$(grep -c 'g turn, above the 30 g' "$TMP/hard.log")" -eq 1 ] || fail "run: the turn warning is not printed exactly once: $(cat "$TMP/hard.log")"
+echo "ok: run prints the warning once, whatever the number of runs"
+checks=$((checks + 1))
+# A log in km read as metres: every range under 100 m.
+printf 'time,range,azimuth,elevation\n0,10,30,1\n1,10.1,30.2,1\n2,10.2,30.4,1\n' > "$TMP/km_log.csv"
+cat > "$TMP/km_log.yaml" <<YAML
+pipeline: {name: km_log, seed: 1, runs: 1}
+nodes:
+  - id: radar
+    type: source.csv
+    params: {path: km_log.csv, sigma_range: 20 m}
+  - id: conv
+    type: convert.classical
+    input: radar
+YAML
+expect_run "a log whose every range is under 100 m is warned about" 0 "warning: .*km_log.yaml:5:20: node 'radar': parameter 'path': every range in '.*km_log.csv' is under 100 m \(the largest is 10.2 m, read with range_unit: m\): a log in km read as metres\? give range_unit: km" \
+  -- "$TF" validate "$TMP/km_log.yaml"
+out=$("$TF" validate "$TMP/km_log.yaml" --set radar.range_unit=km 2>&1) || fail "the km log does not validate with range_unit: km: $out"
+printf '%s\n' "$out" | grep -q warning && fail "range_unit: km still warns: $out"
+echo "ok: with range_unit: km the same log validates without a warning"
+checks=$((checks + 1))
+
 base | sed 's/- id: cm/- id: radar/' > "$TMP/duplicate.yaml"
 expect_run "duplicate id" 2 "duplicate.yaml:14:5: node 'radar': duplicate node id 'radar' \(first defined at .*duplicate.yaml:10:5\)" \
   -- "$TF" validate "$TMP/duplicate.yaml"
@@ -74,6 +116,14 @@ expect_run "--set with a wrong unit" 2 "node 'radar': parameter 'sigma_range' ha
 expect_run "missing file" 2 "cannot open pipeline file" -- "$TF" validate "$TMP/nope.yaml"
 expect_run "unknown command" 2 "unknown command 'rnu' \(did you mean 'run'\?\)" -- "$TF" rnu
 expect_run "describe an unknown type" 2 "did you mean 'sim.radar'" -- "$TF" describe sim.rdar
+# Issue 26: describe opens with the node as a pipeline writes it; with its placeholder replaced
+# by a real input, that node validates.
+"$TF" describe sim.radar > "$TMP/describe.txt" 2>&1 || fail "describe sim.radar failed"
+sed -n 4,6p "$TMP/describe.txt" | tr '\n' '|' | grep -qx '  - id: radar|    type: sim.radar|    input: <a node producing truth>|' ||
+  fail "describe sim.radar does not open with a YAML example: $(head -8 "$TMP/describe.txt")"
+{ truth_radar describe_example 1 1 2 | sed '/^  - id: radar$/,$d'; sed -n '4,6p' "$TMP/describe.txt" | sed 's/<a node producing truth>/truth/'; } \
+  > "$TMP/describe_example.yaml"
+expect_run "describe's example, its input filled in, validates" 0 "ok" -- "$TF" validate "$TMP/describe_example.yaml"
 expect_run "run --help documents exit codes and options" 0 "--threads" -- "$TF" run --help
 expect_run "top-level help lists commands and exit codes" 0 "Exit codes: 0 ok, 1 an .expect. check failed, 2 bad" -- "$TF" --help
 
@@ -137,5 +187,38 @@ expect_run "--set into a misspelt component" 2 "tracker.yaml:6:5: node 'mtt': --
   -- "$TF" validate "$TMP/tracker.yaml" --set mtt.estimatr.q=4
 expect_run "--set into a scalar" 2 "'max_speed' is not a map|'deleter' is|sets no 'max_tracks'" \
   -- "$TF" validate "$TMP/tracker.yaml" --set mtt.max_tracks.q=4
+
+# Issue 26: an index reaches into a list of records or of reals; a wrong index names what is there.
+base | sed 's/segments: .*/segments: [ { type: constant_velocity, duration: 2 s }, { type: turn, turn_rate: 1 deg\/s, duration: 3 s } ]/' \
+  > "$TMP/two_segments.yaml"
+expect_run "--set into a list of records" 0 "ok" -- "$TF" validate "$TMP/two_segments.yaml" --set "truth.segments[1].turn_rate=3 deg/s"
+expect_run "--set into a list of records checks the field" 2 "node 'truth': parameter 'turn_rate' is a quantity in rad/s: write its unit" \
+  -- "$TF" validate "$TMP/two_segments.yaml" --set "truth.segments[1].turn_rate=3"
+expect_run "--set past the end of a list" 2 "node 'truth': --set truth.segments\[5\].turn_rate: 'segments' has 2 elements \(indices 0 to 1\), so no \[5\]" \
+  -- "$TF" validate "$TMP/two_segments.yaml" --set "truth.segments[5].turn_rate=3 deg/s"
+expect_run "--set with an index into a scalar" 2 "'rate' is '10 Hz', not a list to index" \
+  -- "$TF" validate "$TMP/two_segments.yaml" --set "truth.rate[0]=5 Hz"
+expect_run "--set with a bad index" 2 "'\[x\]' is not a list index" \
+  -- "$TF" validate "$TMP/two_segments.yaml" --set "truth.segments[x].turn_rate=3 deg/s"
+"$TF" run "$TMP/two_segments.yaml" --set "truth.initial_position[0]=20 km" --out "$TMP/elem" --metrics-json "$TMP/elem.json" \
+  --no-progress > "$TMP/elem.log" 2>&1 || fail "--set of a list element: the run failed: $(cat "$TMP/elem.log")"
+"$TF" run "$TMP/two_segments.yaml" --out "$TMP/plain" --metrics-json "$TMP/plain.json" --no-progress > "$TMP/plain.log" 2>&1 ||
+  fail "the plain run failed: $(cat "$TMP/plain.log")"
+cmp -s "$TMP/elem.json" "$TMP/plain.json" && fail "--set truth.initial_position[0] changed nothing"
+echo "ok: --set truth.initial_position[0] sets one element of a list of reals"
+checks=$((checks + 1))
+
+# Issue 26: every pipeline in pipelines/ validates, and without a warning (the bare-angle refusal
+# and the plausibility checks must not trip over the project's own experiments).
+ROOT=${4:?cli_errors.sh needs the repo root as its 4th argument}
+for p in "$ROOT"/pipelines/*.yaml; do
+  out=$("$TF" validate "$p" 2>&1) || { printf '%s\n' "$out" >&2; fail "$(basename "$p") does not validate"; }
+  if printf '%s\n' "$out" | grep -qi 'warning'; then
+    printf '%s\n' "$out" >&2
+    fail "$(basename "$p") validates with a warning"
+  fi
+  checks=$((checks + 1))
+done
+echo "ok: every pipeline in pipelines/ validates without a warning"
 
 finish

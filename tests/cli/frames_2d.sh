@@ -37,8 +37,8 @@ expect_run "filter.ekf takes a 2-D radar's polar log" 0 "ekf \(filter.ekf\)" -- 
 python3 - "$TMP/out1/out.csv" <<'PY' || fail "filter.ekf on polar plots left the radar's plane"
 import csv, sys
 rows = [r for r in csv.DictReader(open(sys.argv[1])) if r.get("initialised", "1") in ("1", "true")]
-assert rows and all(abs(float(r["z"])) < 1e-9 for r in rows if r["z"] != ""), "z not 0"
-assert abs(float(rows[-1]["x"]) - 1400) < 60, rows[-1]["x"]
+assert rows and all(abs(float(r["z_m"])) < 1e-9 for r in rows if r["z_m"] != ""), "z not 0"
+assert abs(float(rows[-1]["x_m"]) - 1400) < 60, rows[-1]["x_m"]
 PY
 checks=$((checks + 1))
 echo "ok: the polar track stays in the radar's plane and follows the target"
@@ -76,7 +76,7 @@ expect_run "filter.kalman takes a planar x-y log" 0 "kf \(filter.kalman\)" -- "$
 python3 - "$TMP/out2/out.csv" <<'PY' || fail "filter.kalman on planar plots left z = 0"
 import csv, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
-assert rows and all(r["z"] in ("", "0") or abs(float(r["z"])) == 0.0 for r in rows)
+assert rows and all(r["z_m"] in ("", "0") or abs(float(r["z_m"])) == 0.0 for r in rows)
 PY
 checks=$((checks + 1))
 echo "ok: the planar track stays in z = 0"

@@ -49,10 +49,10 @@ expect_run "a library without the entry point is 'not a trackflow plugin'" 2 "tf
 rm "$TMP/plugins/tfplugin_notours.so"
 # Plugins built against an older SDK are refused at the "abi" stage, naming both versions, and
 # their registration is never run (it traps); the other plugins still load.
-for abi in 3 4 5 6 7; do
+for abi in 3 4 5 6 7 8; do
   cp "$PLUGINS/../old-abi-plugins/tfplugin_test_abi$abi.so" "$TMP/plugins/"
   expect_run "an ABI-$abi plugin is refused with a clear message" 2 \
-    "tfplugin_test_abi$abi.so: abi: built against plugin ABI $abi \\(SDK 0\\.$abi\\.[01]\\); this trackflow needs ABI 8 \\(SDK 0\\.8\\.[0-9]\\): rebuild the plugin" -- \
+    "tfplugin_test_abi$abi.so: abi: built against plugin ABI $abi \\(SDK 0\\.$abi\\.[01]\\); this trackflow needs ABI 9 \\(SDK 0\\.9\\.[0-9]\\): rebuild the plugin" -- \
     "$TF" plugins --no-default-plugins --plugin-path "$TMP/plugins"
   list | grep -q '"sink.metrics"' || fail "an ABI-$abi plugin in the folder stopped the other plugins from loading"
   rm "$TMP/plugins/tfplugin_test_abi$abi.so"

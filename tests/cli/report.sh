@@ -16,7 +16,7 @@ size=$(stat -c %s "$H")
 [ "$size" -lt 5000000 ] || fail "report is $size bytes (limit 5 MB)"
 if grep -Eiq '<(script|img|iframe)[^>]* src=|<link[^>]* href=' "$H"; then fail "the report loads an external file"; fi
 grep -q 'id="tf-charts"' "$H" || fail "no charts in the report"
-for t in 'position RMSE against time' 'ANEES against time - cdkf' 'ANEES against time - adkf' 'ANIS against time - adkf' \
+for t in 'position RMSE against time' 'ANEES against time' 'ANIS against time' \
          'ground track (east-north)' 'altitude against time'; do
   grep -q "data-title=\"$t\"" "$H" || fail "report lacks the plot '$t'"
 done
@@ -77,12 +77,12 @@ expect_run "report --help" 0 "self-contained HTML" -- "$TF" report --help
 "$TF" run "$DATA/report_csv_covariance.yaml" --no-progress --out "$TMP/cov" > "$TMP/cov.log" 2>&1 ||
   fail "sink.csv full_covariance run failed: $(cat "$TMP/cov.log")"
 C="$TMP/cov/tracks.csv"
-head -1 "$C" | grep -q ',truth_vz,cov_x_x,cov_x_y,cov_x_z,cov_x_vx,.*,cov_vy_vz,cov_vz_vz$' ||
+head -1 "$C" | grep -q ',truth_vz_m_per_s,cov_x_x_m2,cov_x_y_m2,cov_x_z_m2,cov_x_vx_m2_per_s,.*,cov_vy_vz_m2_per_s2,cov_vz_vz_m2_per_s2$' ||
   fail "unexpected header: $(head -1 "$C")"
 awk -F, 'NR == 1 { for (i = 1; i <= NF; ++i) col[$i] = i; if (NF != 46) exit 1; next }
   NF != 46 { exit 1 }
-  $col["kind"] == "estimate" { n++; s = $col["sigma_x"]; c = $col["cov_x_x"]; d = s * s - c; if (d < 0) d = -d
-    if (d > 1e-6 * c) exit 1; if ($col["cov_y_vy"] == "") exit 1 }
+  $col["kind"] == "estimate" { n++; s = $col["sigma_x_m"]; c = $col["cov_x_x_m2"]; d = s * s - c; if (d < 0) d = -d
+    if (d > 1e-6 * c) exit 1; if ($col["cov_y_vy_m2_per_s"] == "") exit 1 }
   END { if (n < 10) exit 1 }' "$C" || fail "covariance columns: not 46 fields or sigma_x^2 != cov_x_x"
 echo "ok: sink.csv full_covariance adds 21 columns, cov_x_x = sigma_x^2"
 checks=$((checks + 1))

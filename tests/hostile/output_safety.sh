@@ -34,7 +34,7 @@ echo "ok: ... no file outside --out changed (the links are not written through)"
 checks=$((checks + 1))
 [ -L "$REPO/out/hostile/report.html" ] && fail "report.html is still the link"
 [ -L "$REPO/out/hostile/score.ensemble.csv" ] && fail "score.ensemble.csv is still the link"
-grep -q '^run,time,' "$REPO/out/hostile/tracks.csv" || fail "tracks.csv is not the sink's file"
+grep -q '^run,time_s,' "$REPO/out/hostile/tracks.csv" || fail "tracks.csv is not the sink's file"
 echo "ok: ... the report and the series file replace the links, tracks.csv is written"
 checks=$((checks + 1))
 

@@ -1,17 +1,17 @@
-// Purpose: a plugin as an older SDK built it (ABI 3 to 7, chosen by OLD_ABI): its entry point with that SDK's PluginInfo layout, which the loader must refuse by its ABI number before reading any other field.
+// Purpose: a plugin as an older SDK built it (ABI 3 to 8, chosen by OLD_ABI): its entry point with that SDK's PluginInfo layout, which the loader must refuse by its ABI number before reading any other field.
 #include <boost/dll/alias.hpp>
 
 #include <cstddef>
 
 #ifndef OLD_ABI
-#error "define OLD_ABI (3 to 7)"
+#error "define OLD_ABI (3 to 8)"
 #endif
 
 namespace {
 
 struct Registrar;
 // PluginInfo of SDK 0.3 and 0.4: the ABI number and SDK version first (as in every SDK), then
-// five type sizes and the registration function. SDK 0.5 to 0.7 had more sizes, but a loader must stop
+// five type sizes and the registration function. SDK 0.5 to 0.8 had more sizes, but a loader must stop
 // reading at the ABI number, so the shorter layout stands for it too.
 struct OldPluginInfo {
   int abi_version;
@@ -25,7 +25,7 @@ struct OldPluginInfo {
 void register_nothing(Registrar&) { __builtin_trap(); }
 
 const OldPluginInfo* entry() {
-  static const OldPluginInfo info{OLD_ABI, OLD_ABI == 3 ? "0.3.0" : OLD_ABI == 4 ? "0.4.1" : OLD_ABI == 5 ? "0.5.0" : OLD_ABI == 6 ? "0.6.0" : "0.7.0", "old", 8, 400, 3000, 64, 16,
+  static const OldPluginInfo info{OLD_ABI, OLD_ABI == 3 ? "0.3.0" : OLD_ABI == 4 ? "0.4.1" : OLD_ABI == 5 ? "0.5.0" : OLD_ABI == 6 ? "0.6.0" : OLD_ABI == 7 ? "0.7.0" : "0.8.0", "old", 8, 400, 3000, 64, 16,
                                   register_nothing};
   return &info;
 }

@@ -1,6 +1,8 @@
 // Purpose: a component's parameter declaration (name, type, unit, default, doc) and the validated values it receives.
 #pragma once
 
+#include <boost/config.hpp>
+
 #include <trackflow/error.hpp>
 #include <trackflow/items.hpp>
 #include <trackflow/units.hpp>
@@ -53,6 +55,11 @@ struct ParamSpec {
   // prefix: any name. Its params are validated against that type's own declaration.
   std::vector<ComponentKind> kinds;
   std::string type_prefix;
+  // Real and RealList: a value whose magnitude is above plausible_max_abs (SI) is valid but
+  // seldom meant; validate and run warn, naming the parameter's line, with implausible_hint
+  // saying what is most often meant (issue 26: an angle sigma of 2 rad is degrees written as rad).
+  double plausible_max_abs = std::numeric_limits<double>::infinity();
+  std::string implausible_hint;
 
   // Fluent construction, e.g.
   //   ParamSpec::real("sigma_range", dim::length, "range noise σ").def("10 m").at_least(0)
@@ -98,6 +105,13 @@ struct ParamSpec {
   ParamSpec at_least(double v) && { min = v; return std::move(*this); }
   ParamSpec at_most(double v) && { max = v; return std::move(*this); }
   ParamSpec positive() && { min = std::numeric_limits<double>::denorm_min(); return std::move(*this); }
+  // A warning above `max_abs` (SI), e.g. .plausible_up_to(0.3, "an angle sigma above 0.3 rad (17 deg)
+  // is most often degrees written as radians").
+  ParamSpec plausible_up_to(double max_abs, std::string hint) && {
+    plausible_max_abs = max_abs;
+    implausible_hint = std::move(hint);
+    return std::move(*this);
+  }
 };
 
 class Params;
@@ -159,6 +173,10 @@ class Params {
   const std::string& node() const { return node_; }
   // A ConfigError pointing at the parameter's line in the analyst's file.
   ConfigError error(std::string_view name, const std::string& message) const;
+  // A warning pointing at the parameter's line: the value is valid but seldom meant (a turn of
+  // 40 g). `validate` and `run` print it; the pipeline still runs. For checks a declaration's
+  // plausible_up_to cannot state (they need several parameters); call it from the factory.
+  void warn(std::string_view name, const std::string& message) const;
 
   // Engine side.
   void set(std::string name, ParamValue v) { values_.emplace_back(std::move(name), std::move(v)); }
@@ -194,5 +212,14 @@ struct NestedComponent {
   // modes). Throws ConfigError at the `type:` value when the type declares no estimator.
   std::unique_ptr<Estimator> create_estimator() const;
 };
+
+namespace detail {
+// The host's side of Params::warn. While a collector is installed on this thread (the host builds
+// a graph), warnings are appended to it as "file:line:col: node 'n': parameter 'p': message", each
+// once; with none installed (a run constructing the same components again) they are dropped, as
+// they were reported when the graph was built. Returns the previous collector.
+BOOST_SYMBOL_VISIBLE std::vector<std::string>* install_setup_warnings(std::vector<std::string>* collector);
+BOOST_SYMBOL_VISIBLE void note_setup_warning(const std::string& text);
+}  // namespace detail
 
 }  // namespace trackflow

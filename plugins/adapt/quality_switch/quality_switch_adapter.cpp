@@ -1,6 +1,7 @@
 // Purpose: adapt.quality_switch — grades each radar channel BEST/NORMAL/WORST from the RMS of successive differences and switches q and R from beacon/skin tables (paper 000 §III.2).
 #include "difference_window.hpp"
 
+#include <trackflow/common_params.hpp>
 #include <trackflow/geometry.hpp>
 #include <trackflow/noise.hpp>
 #include <trackflow/plugin.hpp>
@@ -285,7 +286,8 @@ std::vector<ParamSpec> row_fields() {
           .req()
           .at_least(0),
       ParamSpec::real("sigma_range", dim::length, "range sigma of R (default: the measurement's own)").positive(),
-      ParamSpec::real("sigma_angle", dim::angle, "azimuth and elevation sigma of R (default: the measurement's own)").positive(),
+      ParamSpec::real("sigma_angle", dim::angle, "azimuth and elevation sigma of R (default: the measurement's own)").positive()
+          .plausible_up_to(kPlausibleAngleSigma, kAngleSigmaHint),
   };
 }
 

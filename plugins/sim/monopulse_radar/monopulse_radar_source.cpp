@@ -336,10 +336,12 @@ void register_components(Registrar& r) {
       ParamSpec::real("reported_sigma_range", dim::length, "range sigma in the reported covariance").def("1 m").positive(),
       ParamSpec::real("reported_sigma_azimuth", dim::angle, "azimuth sigma in the reported covariance (a fixed-R filter's R)")
           .def("100 urad")
-          .positive(),
+          .positive()
+          .plausible_up_to(kPlausibleAngleSigma, kAngleSigmaHint),
       ParamSpec::real("reported_sigma_elevation", dim::angle, "elevation sigma in the reported covariance")
           .def("100 urad")
-          .positive(),
+          .positive()
+          .plausible_up_to(kPlausibleAngleSigma, kAngleSigmaHint),
       ParamSpec::choice<Antenna>("antenna", {{Antenna::FourHorn, "four_horn"}, {Antenna::Linear, "linear"}},
                                  "four-horn amplitude comparison (eq 2-1..2-12, non-linear off boresight) or an ideal "
                                  "linear discriminator")

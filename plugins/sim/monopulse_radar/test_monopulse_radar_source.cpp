@@ -135,7 +135,7 @@ TEST_CASE("swerling2 snr is exponential and fades are missed") {
 TEST_CASE("four horn error is non-linear off boresight") {
   const double delta = 0.25 * kBeamwidth;
   const std::string common = "rcs_model: constant, glint: false, thermal: false, sigma_range: 0 m, pointing_error_azimuth: " +
-                             fixed(delta) + ", pointing_error_elevation: 0 rad";
+                             fixed(delta) + " rad, pointing_error_elevation: 0 rad";
   const Looks four = look("{ " + common + " }", 50e3, 3, 0.05);
   const Looks lin = look("{ antenna: linear, " + common + " }", 50e3, 3, 0.05);
   double u_az, u_el;

@@ -247,8 +247,10 @@ std::vector<ParamSpec> window_fields(bool with_mode) {
                                           "tracking mode written into measurements in this window")
                   .req());
   f.push_back(ParamSpec::real("sigma_range", dim::length, "range sigma in this window (default: the noise model's)").at_least(0));
-  f.push_back(ParamSpec::real("sigma_azimuth", dim::angle, "azimuth sigma in this window (default: the noise model's)").at_least(0));
-  f.push_back(ParamSpec::real("sigma_elevation", dim::angle, "elevation sigma in this window (default: the noise model's)").at_least(0));
+  f.push_back(ParamSpec::real("sigma_azimuth", dim::angle, "azimuth sigma in this window (default: the noise model's)").at_least(0)
+                  .plausible_up_to(kPlausibleAngleSigma, kAngleSigmaHint));
+  f.push_back(ParamSpec::real("sigma_elevation", dim::angle, "elevation sigma in this window (default: the noise model's)").at_least(0)
+                  .plausible_up_to(kPlausibleAngleSigma, kAngleSigmaHint));
   f.push_back(ParamSpec::real("sigma_range_rate", dim::velocity, "range-rate sigma in this window (default: the noise model's)")
                   .at_least(0));
   return f;
@@ -326,10 +328,12 @@ void register_components(Registrar& r) {
                         "paper 000 Table 4 over range")
           .def("constant"),
       ParamSpec::real("sigma_range", dim::length, "constant model: range noise standard deviation").def("10 m").at_least(0),
-      ParamSpec::real("sigma_azimuth", dim::angle, "constant model: azimuth noise standard deviation").def("1 mrad").at_least(0),
+      ParamSpec::real("sigma_azimuth", dim::angle, "constant model: azimuth noise standard deviation").def("1 mrad").at_least(0)
+          .plausible_up_to(kPlausibleAngleSigma, kAngleSigmaHint),
       ParamSpec::real("sigma_elevation", dim::angle, "constant model: elevation noise standard deviation")
           .def("1 mrad")
-          .at_least(0),
+          .at_least(0)
+          .plausible_up_to(kPlausibleAngleSigma, kAngleSigmaHint),
       ParamSpec::boolean("range_rate", "also measure range rate (4th element of the value)").def("false"),
       ParamSpec::real("sigma_range_rate", dim::velocity, "range-rate noise standard deviation (when range_rate; all models)")
           .def("1 m/s")

@@ -337,8 +337,10 @@ void register_components(Registrar& r) {
       azimuth_convention_param("azimuth reference: compass bearing, or math angle from east toward north"),
       ParamSpec::integer("sensor_id", "sensor number written into each Scan").def("0").at_least(0).at_most(4294967295.0),
       ParamSpec::real("sigma_range", dim::length, "range noise standard deviation").def("10 m").at_least(0),
-      ParamSpec::real("sigma_azimuth", dim::angle, "azimuth noise standard deviation").def("1 mrad").at_least(0),
-      ParamSpec::real("sigma_elevation", dim::angle, "elevation noise standard deviation").def("1 mrad").at_least(0),
+      ParamSpec::real("sigma_azimuth", dim::angle, "azimuth noise standard deviation").def("1 mrad").at_least(0)
+          .plausible_up_to(kPlausibleAngleSigma, kAngleSigmaHint),
+      ParamSpec::real("sigma_elevation", dim::angle, "elevation noise standard deviation").def("1 mrad").at_least(0)
+          .plausible_up_to(kPlausibleAngleSigma, kAngleSigmaHint),
       ParamSpec::choice<DetectionModel>("detection_model",
                                         {{DetectionModel::Constant, "constant"},
                                          {DetectionModel::Swerling0, "swerling0"},

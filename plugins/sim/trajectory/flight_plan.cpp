@@ -4,8 +4,11 @@
 #include "geodetic_launch.hpp"
 #include "launch_profile.hpp"
 
+#include <trackflow/number_text.hpp>
+
 #include <algorithm>
 #include <cmath>
+#include <numbers>
 #include <string>
 
 namespace trackflow::sim {
@@ -123,6 +126,23 @@ Kinematics evaluate(const MotionPiece& p, double t) {
   return {p.position, p.velocity, Vec3::Zero()};
 }
 
+namespace {
+
+// A coordinated turn's lateral acceleration is |w| times the horizontal speed; above 30 g no
+// aircraft or missile sustains it (issue 26: `turn_rate: 3`, read as 3 rad/s, is 61 g at 200 m/s).
+// Valid, so a warning, not an error: the turn_rate declaration cannot say it, it needs the speed.
+void warn_if_implausible_turn(const Params& rec, const std::string& label, double turn_rate, const Vec3& v) {
+  constexpr double g0 = 9.80665, kMaxPlausible = 30 * g0;
+  const double lateral = std::abs(turn_rate) * std::hypot(v.x(), v.y());
+  if (!(lateral > kMaxPlausible)) return;
+  rec.warn("turn_rate", label + ": " + number_text::general(turn_rate * 180 / std::numbers::pi, 4) + " deg/s at " +
+                            number_text::general(std::hypot(v.x(), v.y()), 4) + " m/s horizontal speed is a " +
+                            number_text::general(lateral / g0, 3) +
+                            " g turn, above the 30 g that no aircraft or missile sustains; a rate in deg/s written as rad/s?");
+}
+
+}  // namespace
+
 std::vector<MotionPiece> build_flight_plan(const Params& params) {
   // Worded and located as the validator words a missing required parameter (the declaration
   // cannot mark them required: a launch profile replaces them).
@@ -160,6 +180,7 @@ std::vector<MotionPiece> build_flight_plan(const Params& params) {
     } else if (type == SegmentType::Turn) {
       piece.motion = Motion::Turn;
       piece.turn_rate = rec.real("turn_rate");
+      warn_if_implausible_turn(rec, label, piece.turn_rate, v);
     }
     const Kinematics end = evaluate(piece, piece.end);
     p = end.position;

@@ -27,9 +27,12 @@
 namespace trackflow {
 namespace {
 
+// Units in the column names (SI; "/" written "_per_"), so pandas.read_csv gives named, unit-carrying
+// columns (issue 26: the README said every output carries its units).
 constexpr const char* kHeader =
-    "run,time,source,kind,updated,x,y,z,vx,vy,vz,sigma_x,sigma_y,sigma_z,sigma_vx,sigma_vy,sigma_vz,nis,nees,"
-    "truth_x,truth_y,truth_z,truth_vx,truth_vy,truth_vz";
+    "run,time_s,source,kind,updated,x_m,y_m,z_m,vx_m_per_s,vy_m_per_s,vz_m_per_s,"
+    "sigma_x_m,sigma_y_m,sigma_z_m,sigma_vx_m_per_s,sigma_vy_m_per_s,sigma_vz_m_per_s,nis,nees,"
+    "truth_x_m,truth_y_m,truth_z_m,truth_vx_m_per_s,truth_vy_m_per_s,truth_vz_m_per_s";
 
 // With an input of track sets (a tracker): each track's id and status, after the truth columns.
 constexpr const char* kTrackHeader = ",track_id,track_status";
@@ -38,10 +41,12 @@ constexpr const char* kTrackHeader = ",track_id,track_status";
 constexpr const char* kOriginHeader = ",origin";
 
 // Opt-in (full_covariance): the upper triangle of the ENU covariance, row by row; units m2,
-// m2/s and m2/s2 (the sigma_* columns are the square roots of its diagonal).
+// m2/s and m2/s2 in the names (the sigma_* columns are the square roots of its diagonal).
 constexpr const char* kCovarianceHeader =
-    ",cov_x_x,cov_x_y,cov_x_z,cov_x_vx,cov_x_vy,cov_x_vz,cov_y_y,cov_y_z,cov_y_vx,cov_y_vy,cov_y_vz,cov_z_z,cov_z_vx,"
-    "cov_z_vy,cov_z_vz,cov_vx_vx,cov_vx_vy,cov_vx_vz,cov_vy_vy,cov_vy_vz,cov_vz_vz";
+    ",cov_x_x_m2,cov_x_y_m2,cov_x_z_m2,cov_x_vx_m2_per_s,cov_x_vy_m2_per_s,cov_x_vz_m2_per_s"
+    ",cov_y_y_m2,cov_y_z_m2,cov_y_vx_m2_per_s,cov_y_vy_m2_per_s,cov_y_vz_m2_per_s,cov_z_z_m2"
+    ",cov_z_vx_m2_per_s,cov_z_vy_m2_per_s,cov_z_vz_m2_per_s,cov_vx_vx_m2_per_s2,cov_vx_vy_m2_per_s2"
+    ",cov_vx_vz_m2_per_s2,cov_vy_vy_m2_per_s2,cov_vy_vz_m2_per_s2,cov_vz_vz_m2_per_s2";
 
 // Truth samples within this of an item's time are its truth (the same default as sink.metrics).
 constexpr double kTimeTolerance = 1e-6;
@@ -635,8 +640,9 @@ void register_components(Registrar& r) {
   d.summary = "Writes estimates (any number of filters), track sets, scans' detections, optional measurements and matching "
               "truth of all runs to one CSV file";
   d.doc =
-      "Columns: run,time,source,kind,updated,x,y,z,vx,vy,vz,sigma_x..sigma_vz,nis,nees,truth_x..truth_vz"
-      "[,cov_x_x,cov_x_y,...,cov_vz_vz], then one column per annotation the pipeline's adapters publish on the "
+      "Columns, SI units in their names: run,time_s,source,kind,updated,x_m,y_m,z_m,vx_m_per_s,vy_m_per_s,vz_m_per_s,"
+      "sigma_x_m..sigma_vz_m_per_s,nis,nees,truth_x_m..truth_vz_m_per_s[,cov_x_x_m2,cov_x_y_m2,...,cov_vz_vz_m2_per_s2], "
+      "then one column per annotation the pipeline's adapters publish on the "
       "estimates of this sink's inputs, named <adapter id>.<name> (e.g. qs.grade_range: adapt.quality_switch's "
       "grade, 0 best, 1 normal, 2 worst; adaptive_r.sigma_x: adapt.innovation_r's adapted sigma, m), empty when the "
       "adapter has published none yet. source is the upstream node id; kind is estimate, measurement or track. "

@@ -33,8 +33,9 @@ const InputInfo kTruth{"truth", "sim.trajectory", mask(ItemKind::Truth)};
 const InputInfo kCm{"cm", "convert.classical", mask(ItemKind::Measurement)};
 
 const std::string kHeader =
-    "run,time,source,kind,updated,x,y,z,vx,vy,vz,sigma_x,sigma_y,sigma_z,sigma_vx,sigma_vy,sigma_vz,nis,nees,"
-    "truth_x,truth_y,truth_z,truth_vx,truth_vy,truth_vz,qs.grade_range,qs.grade_azimuth,qs.grade_elevation";
+    "run,time_s,source,kind,updated,x_m,y_m,z_m,vx_m_per_s,vy_m_per_s,vz_m_per_s,sigma_x_m,sigma_y_m,sigma_z_m,"
+    "sigma_vx_m_per_s,sigma_vy_m_per_s,sigma_vz_m_per_s,nis,nees,truth_x_m,truth_y_m,truth_z_m,truth_vx_m_per_s,"
+    "truth_vy_m_per_s,truth_vz_m_per_s,qs.grade_range,qs.grade_azimuth,qs.grade_elevation";
 enum Col { Run, Time, Source, Kind, Updated, X, Y, Z, VX, VY, VZ, SX, SY, SZ, SVX, SVY, SVZ, Nis, Nees, TX, TY, TZ, TVX, TVY, TVZ,
            QR, QAZ, QEL, Cells };
 

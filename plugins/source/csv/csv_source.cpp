@@ -5,11 +5,11 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <trackflow/common_params.hpp>
 #include <trackflow/data_files.hpp>
+#include <trackflow/geometry.hpp>
 #include <trackflow/number_range.hpp>
 #include <trackflow/number_text.hpp>
-#include <trackflow/geometry.hpp>
-#include <trackflow/common_params.hpp>
 #include <trackflow/plugin.hpp>
 #include <trackflow/scan.hpp>
 
@@ -107,7 +107,23 @@ void open_file(const Params& p, const fs::path& path, FileHandle& file, FileStam
     throw p.error("path", "'" + path.string() + "' is not a regular file");
   // O_NONBLOCK: a file swapped for a FIFO after the check must not block the open either.
   file.fd = ::open(path.c_str(), O_RDONLY | O_CLOEXEC | O_NONBLOCK);
-  if (file.fd < 0) throw p.error("path", "cannot open '" + path.string() + "': " + std::strerror(errno));
+  if (file.fd < 0) {
+    const int error = errno;
+    // The path as resolved, absolute, and how it was resolved: a relative path is read from the
+    // pipeline file's folder, not from where trackflow was started (issue 26).
+    std::error_code ignored;
+    const fs::path absolute = fs::absolute(path, ignored).lexically_normal();
+    const std::string& written = p.text("path");
+    std::string how;
+    const std::string& written_in = p.where("path").file;
+    if (fs::path(written).is_relative())
+      how = " (path '" + written + "' is read relative to " +
+            (!written_in.empty() && fs::is_regular_file(written_in, ignored)
+                 ? "the folder of the file that names it, '" + written_in + "'"
+                 : std::string("the working directory")) +
+            ")";
+    throw p.error("path", "cannot open '" + absolute.string() + "': " + std::strerror(error) + how);
+  }
   struct stat info;
   if (::fstat(file.fd, &info) != 0) throw p.error("path", "cannot read '" + path.string() + "': " + std::strerror(errno));
   if (!S_ISREG(info.st_mode)) throw p.error("path", "'" + path.string() + "' is not a regular file");
@@ -162,6 +178,7 @@ struct CheckedLog {
   std::size_t skipped_count = 0;
   std::size_t rows_read = 0;
   std::size_t scans = 0, largest_scan = 0;  // content: detections
+  double largest_range = 0;  // frame spherical or polar: of the good rows, in m
 };
 constexpr std::size_t kMaxSkipMessages = 1000;
 
@@ -231,6 +248,7 @@ class CsvSource final : public Generator {
       cache.logs[key] = log_;
     }
     cache.latest = log_;
+    warn_if_ranges_short(p);
     for (int i = 0; i < kColumns; ++i) columns()[i]->index = log_->column_index[i];
     field_count_ = log_->field_count;
     header_number_ = log_->header_line;
@@ -238,6 +256,16 @@ class CsvSource final : public Generator {
     stream_ = csv::LineStream(log_->buffer);
     fields_.reserve(field_count_ + 1);
     detections_.reserve(log_->largest_scan);
+  }
+
+  // A surveillance or tracking radar's log whose every range is under 100 m is almost always a log
+  // in km read as metres (issue 26: it otherwise shows only as a "near the zenith" warning).
+  void warn_if_ranges_short(const Params& p) const {
+    if ((frame_ != Frame::Spherical && frame_ != Frame::Polar) || content_ == Content::Truth) return;
+    if (log_->good_rows == 0 || log_->largest_range >= 100.0 || log_->largest_range == 0.0) return;
+    p.warn(p.given("range_unit") ? "range_unit" : "path",
+           "every range in '" + file_ + "' is under 100 m (the largest is " + number_text::general(log_->largest_range, 4) +
+               " m, read with range_unit: " + p.choice_word("range_unit") + "): a log in km read as metres? give range_unit: km");
   }
 
   void start_run(const RunContext& ctx) override {
@@ -519,6 +547,8 @@ class CsvSource final : public Generator {
         longest = std::max(longest, line.text.size());
         if (read_row(line, reader.done(), fields, current_, &why)) {
           ++log.good_rows;
+          if ((frame_ == Frame::Spherical || frame_ == Frame::Polar) && content_ != Content::Truth && !row_empty_)
+            log.largest_range = std::max(log.largest_range, std::abs(current_.value(0)));
           if (content_ == Content::Detections) {
             if (log.scans == 0 || !same_scan(group_time, group_key, current_.time, row_scan_)) {
               ++log.scans;
@@ -805,8 +835,10 @@ std::vector<ParamSpec> csv_params() {
           .def("deg"),
       length_unit_param("position_unit", "cartesian, planar: unit of x, y, z (and range rate per second)"),
       P::real("sigma_range", dim::length, "spherical, polar: range noise standard deviation").def("10 m").positive(),
-      P::real("sigma_azimuth", dim::angle, "spherical, polar: azimuth noise standard deviation").def("1 mrad").positive(),
-      P::real("sigma_elevation", dim::angle, "spherical: elevation noise standard deviation").def("1 mrad").positive(),
+      P::real("sigma_azimuth", dim::angle, "spherical, polar: azimuth noise standard deviation").def("1 mrad").positive()
+          .plausible_up_to(kPlausibleAngleSigma, kAngleSigmaHint),
+      P::real("sigma_elevation", dim::angle, "spherical: elevation noise standard deviation").def("1 mrad").positive()
+          .plausible_up_to(kPlausibleAngleSigma, kAngleSigmaHint),
       P::real("sigma_range_rate", dim::velocity, "range-rate noise standard deviation").def("1 m/s").positive(),
       P::real("sigma_position", dim::length, "cartesian, planar: noise standard deviation of each position value")
           .def("10 m")

@@ -25,6 +25,9 @@ struct Graph {
   std::vector<GraphNode> nodes;
   std::vector<int> order;    // topological: every node after its inputs
   std::vector<DeclaredOutput> outputs;  // the files the nodes declared at construction (output_path.hpp)
+  // Valid but seldom meant ("file:line:col: node 'n': parameter 'p' = ... is valid but
+  // implausible: ..."): a declaration's plausible range and the plugins' Params::warn, each once.
+  std::vector<std::string> warnings;
 };
 
 // Collects nothing silently: the first problem is thrown as a ConfigError naming file:line:col

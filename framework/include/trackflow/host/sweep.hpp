@@ -1,4 +1,4 @@
-// Purpose: parameter grids for `trackflow sweep`: parsing --param axes and enumerating the grid points.
+// Purpose: parameter grids for `trackflow sweep`: parsing --param axes and enumerating the grid points (a product, or zipped axes).
 #pragma once
 
 #include <trackflow/host/config.hpp>
@@ -23,5 +23,9 @@ SweepAxis parse_sweep_axis(const std::string& text);
 
 // The Cartesian product, first axis slowest: each point is one override per axis.
 std::vector<std::vector<Override>> sweep_grid(const std::vector<SweepAxis>& axes);
+
+// --zip: the axes move together, point i takes the i-th value of each (every list the same
+// length): `--param kf.q=1,10 --param ukf.q=1,10 --zip` is 2 points, not 4.
+std::vector<std::vector<Override>> sweep_zip(const std::vector<SweepAxis>& axes);
 
 }  // namespace trackflow::host
